@@ -1,0 +1,131 @@
+// bireg: SE(3), rigid motions, as 4x4 homogeneous matrices [R t; 0 1].
+//
+// Tangent coordinates, translation first: xi = (rho, omega), with
+// hat(xi) = [hat(omega) rho; 0 0] (the order of Sophus and manif).
+//
+// exp: R = exp_SO3(omega), t = V rho,
+//      V = I + ((1 - cos th)/th^2) W + ((th - sin th)/th^3) W^2;
+// log: omega = log_SO3(R), rho = V^{-1} t,
+//      V^{-1} = I - W/2 + ((1 - (th/2) cot(th/2))/th^2) W^2,
+// with W = hat(omega), th = |omega|. All three coefficients are evaluated
+// without cancellation (small_angle.hpp); V is applied with cross products.
+#pragma once
+
+#include <cmath>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>  // cross()
+
+#include "bireg/core/small_angle.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/groups/tolerance.hpp"
+
+namespace bireg {
+
+template <class Scalar_>
+struct SE3 {
+  using Scalar = Scalar_;
+  static constexpr int dof = 6;
+  static constexpr int matrix_size = 4;
+  static constexpr const char* name = "SE3";
+  using Element = Eigen::Matrix<Scalar, 4, 4>;
+  using Tangent = Eigen::Matrix<Scalar, 6, 1>;
+  using AdMatrix = Eigen::Matrix<Scalar, 6, 6>;
+  using Algebra = Eigen::Matrix<Scalar, 4, 4>;
+  using Rotation = SO3<Scalar>;
+  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
+
+  static Element identity() { return Element::Identity(); }
+  static Element compose(const Element& a, const Element& b) {
+    Element g = Element::Identity();
+    g.template topLeftCorner<3, 3>() =
+        a.template topLeftCorner<3, 3>() * b.template topLeftCorner<3, 3>();
+    g.template topRightCorner<3, 1>() =
+        a.template topLeftCorner<3, 3>() * b.template topRightCorner<3, 1>() +
+        a.template topRightCorner<3, 1>();
+    return g;
+  }
+  static Element inverse(const Element& g) {
+    Element inv = Element::Identity();
+    const Matrix3 rt = g.template topLeftCorner<3, 3>().transpose();
+    inv.template topLeftCorner<3, 3>() = rt;
+    inv.template topRightCorner<3, 1>() = -rt * g.template topRightCorner<3, 1>();
+    return inv;
+  }
+
+  static Element exp(const Tangent& xi) {
+    using std::sqrt;
+    const Vector3 rho = xi.template head<3>();
+    const Vector3 omega = xi.template tail<3>();
+    const Scalar theta = sqrt(omega.squaredNorm());
+    const Scalar b = small_angle::one_minus_cos_over_x2(theta);
+    const Scalar c = small_angle::x_minus_sin_over_x3(theta);
+    const Vector3 w_rho = omega.cross(rho);
+    Element g = Element::Identity();
+    g.template topLeftCorner<3, 3>() = Rotation::exp(omega);
+    g.template topRightCorner<3, 1>() = rho + b * w_rho + c * omega.cross(w_rho);
+    return g;
+  }
+
+  // Principal logarithm: |omega| in [0, pi].
+  static Tangent log(const Element& g) {
+    using std::sqrt;
+    const Vector3 omega = Rotation::log(g.template topLeftCorner<3, 3>());
+    const Vector3 t = g.template topRightCorner<3, 1>();
+    const Scalar theta = sqrt(omega.squaredNorm());
+    const Scalar e = small_angle::one_minus_half_x_cot_half_x_over_x2(theta);
+    const Vector3 w_t = omega.cross(t);
+    Tangent xi;
+    xi.template head<3>() = t - w_t / Scalar(2) + e * omega.cross(w_t);
+    xi.template tail<3>() = omega;
+    return xi;
+  }
+
+  static Algebra hat(const Tangent& xi) {
+    Algebra m = Algebra::Zero();
+    m.template topLeftCorner<3, 3>() = Rotation::hat(xi.template tail<3>());
+    m.template topRightCorner<3, 1>() = xi.template head<3>();
+    return m;
+  }
+  static Tangent vee(const Algebra& m) {
+    Tangent xi;
+    xi.template head<3>() = m.template topRightCorner<3, 1>();
+    xi.template tail<3>() = Rotation::vee(m.template topLeftCorner<3, 3>());
+    return xi;
+  }
+
+  // [xi_1, xi_2] = (w1 x rho2 - w2 x rho1, w1 x w2), so
+  // ad_xi = [hat(omega) hat(rho); 0 hat(omega)].
+  static AdMatrix ad(const Tangent& xi) {
+    AdMatrix m = AdMatrix::Zero();
+    const Matrix3 w = Rotation::hat(xi.template tail<3>());
+    m.template topLeftCorner<3, 3>() = w;
+    m.template bottomRightCorner<3, 3>() = w;
+    m.template topRightCorner<3, 3>() = Rotation::hat(xi.template head<3>());
+    return m;
+  }
+
+  // g hat(xi) g^{-1} = hat(R rho + t x (R omega), R omega):
+  // Ad_g = [R hat(t) R; 0 R].
+  static AdMatrix Ad(const Element& g) {
+    AdMatrix m = AdMatrix::Zero();
+    const Matrix3 r = g.template topLeftCorner<3, 3>();
+    m.template topLeftCorner<3, 3>() = r;
+    m.template bottomRightCorner<3, 3>() = r;
+    m.template topRightCorner<3, 3>() = Rotation::hat(g.template topRightCorner<3, 1>()) * r;
+    return m;
+  }
+
+  // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
+  // to within tol (max-norm), all finite.
+  static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {
+    if (!g.allFinite()) return false;
+    const Scalar last_row = (g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 4>(0, 0, 0, 1))
+                                .cwiseAbs()
+                                .maxCoeff();
+    return last_row <= tol && Rotation::is_element(g.template topLeftCorner<3, 3>(), tol);
+  }
+};
+
+}  // namespace bireg

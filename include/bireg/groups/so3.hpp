@@ -1,0 +1,123 @@
+// bireg: SO(3), 3D rotations, as 3x3 rotation matrices.
+//
+// Tangent coordinates: the rotation vector omega (axis times angle), with
+// hat(omega) the skew matrix such that hat(omega) v = omega x v.
+//
+// exp is Rodrigues' formula with half-angle coefficients (no cancellation at
+// any angle). log goes through a unit quaternion obtained by Shepperd's
+// method (the largest of the four candidate components is computed from the
+// diagonal, the other three from off-diagonal sums or differences), and the
+// angle is 2 atan2(|v|, w). Unlike acos((tr R - 1)/2) or formulas that divide
+// by sin(theta), this keeps full relative precision at every angle, including
+// theta -> 0 and theta -> pi, and tolerates inputs slightly off the group.
+#pragma once
+
+#include <cmath>
+
+#include <Eigen/Core>
+
+#include "bireg/core/small_angle.hpp"
+#include "bireg/groups/tolerance.hpp"
+
+namespace bireg {
+
+template <class Scalar_>
+struct SO3 {
+  using Scalar = Scalar_;
+  static constexpr int dof = 3;
+  static constexpr int matrix_size = 3;
+  static constexpr const char* name = "SO3";
+  using Element = Eigen::Matrix<Scalar, 3, 3>;
+  using Tangent = Eigen::Matrix<Scalar, 3, 1>;
+  using AdMatrix = Eigen::Matrix<Scalar, 3, 3>;
+  using Algebra = Eigen::Matrix<Scalar, 3, 3>;
+  using Quaternion = Eigen::Matrix<Scalar, 4, 1>;  // (w, x, y, z)
+
+  static Element identity() { return Element::Identity(); }
+  static Element compose(const Element& a, const Element& b) { return a * b; }
+  static Element inverse(const Element& g) { return g.transpose(); }
+
+  // R = I + (sin t / t) W + ((1 - cos t)/t^2) W^2, W = hat(omega), t = |omega|.
+  // With h = t/2: sin t / t = sinc(h) cos(h) and (1 - cos t)/t^2 = sinc(h)^2/2,
+  // so one sin/cos pair of the half angle gives both, without cancellation.
+  static Element exp(const Tangent& omega) {
+    using std::cos;
+    using std::sqrt;
+    const Scalar half_angle = sqrt(omega.squaredNorm()) / Scalar(2);
+    const Scalar sinc_half = small_angle::sin_over_x(half_angle);
+    const Scalar sin_over_angle = sinc_half * cos(half_angle);
+    const Scalar one_minus_cos_over_angle2 = sinc_half * sinc_half / Scalar(2);
+    const Algebra w = hat(omega);
+    return Element::Identity() + sin_over_angle * w + one_minus_cos_over_angle2 * (w * w);
+  }
+
+  // Unit quaternion (w >= 0) of a rotation matrix by Shepperd's method. For a
+  // matrix slightly off SO(3) the result is not exactly unit; log() only
+  // uses ratios of its components, so that does not matter there.
+  static Quaternion to_quaternion(const Element& r) {
+    using std::sqrt;
+    const Scalar trace = r(0, 0) + r(1, 1) + r(2, 2);
+    Quaternion q;  // 4 q_a q_b are linear in r for every pair (a, b)
+    if (trace >= r(0, 0) && trace >= r(1, 1) && trace >= r(2, 2)) {
+      const Scalar four_w = Scalar(2) * sqrt(Scalar(1) + trace);
+      q << four_w / Scalar(4), (r(2, 1) - r(1, 2)) / four_w, (r(0, 2) - r(2, 0)) / four_w,
+          (r(1, 0) - r(0, 1)) / four_w;
+    } else if (r(0, 0) >= r(1, 1) && r(0, 0) >= r(2, 2)) {
+      const Scalar four_x = Scalar(2) * sqrt(Scalar(1) + r(0, 0) - r(1, 1) - r(2, 2));
+      q << (r(2, 1) - r(1, 2)) / four_x, four_x / Scalar(4), (r(0, 1) + r(1, 0)) / four_x,
+          (r(0, 2) + r(2, 0)) / four_x;
+    } else if (r(1, 1) >= r(2, 2)) {
+      const Scalar four_y = Scalar(2) * sqrt(Scalar(1) - r(0, 0) + r(1, 1) - r(2, 2));
+      q << (r(0, 2) - r(2, 0)) / four_y, (r(0, 1) + r(1, 0)) / four_y, four_y / Scalar(4),
+          (r(1, 2) + r(2, 1)) / four_y;
+    } else {
+      const Scalar four_z = Scalar(2) * sqrt(Scalar(1) - r(0, 0) - r(1, 1) + r(2, 2));
+      q << (r(1, 0) - r(0, 1)) / four_z, (r(0, 2) + r(2, 0)) / four_z, (r(1, 2) + r(2, 1)) / four_z,
+          four_z / Scalar(4);
+    }
+    if (q[0] < Scalar(0)) q = -q;
+    return q;
+  }
+
+  // Principal logarithm: |omega| in [0, pi]. At exactly pi both +-omega are
+  // logarithms; the one with the sign of the chosen quaternion is returned.
+  // omega = (theta / |v|) v with theta = 2 atan2(|v|, w). For w > |v|
+  // (angles below pi/2) theta/|v| = (2/w) atan(y)/y with y = |v|/w, whose
+  // series covers |v| -> 0 without forming |v| (no underflow at 1e-300).
+  static Tangent log(const Element& r) {
+    using std::atan2;
+    using std::sqrt;
+    const Quaternion q = to_quaternion(r);
+    const Scalar w = q[0];
+    const Tangent v = q.template tail<3>();
+    const Scalar v_norm2 = v.squaredNorm();
+    if (w * w > v_norm2) {
+      const Scalar y = sqrt(v_norm2) / w;
+      return (Scalar(2) / w * small_angle::atan_over_y(y)) * v;
+    }
+    const Scalar v_norm = sqrt(v_norm2);
+    return (Scalar(2) * atan2(v_norm, w) / v_norm) * v;
+  }
+
+  static Algebra hat(const Tangent& omega) {
+    Algebra m;
+    m << Scalar(0), -omega[2], omega[1], omega[2], Scalar(0), -omega[0], -omega[1], omega[0],
+        Scalar(0);
+    return m;
+  }
+  static Tangent vee(const Algebra& m) { return Tangent(m(2, 1), m(0, 2), m(1, 0)); }
+
+  // [hat a, hat b] = hat(a x b), so ad_a = hat(a); Ad_R = R.
+  static AdMatrix ad(const Tangent& omega) { return hat(omega); }
+  static AdMatrix Ad(const Element& r) { return r; }
+
+  // Orthonormal with determinant +1, to within tol (max-norm), and finite.
+  static bool is_element(const Element& r, Scalar tol = default_element_tolerance<Scalar>()) {
+    using std::abs;
+    if (!r.allFinite()) return false;
+    const Scalar orthonormality = (r.transpose() * r - Element::Identity()).cwiseAbs().maxCoeff();
+    return orthonormality <= tol && abs(r.determinant() - Scalar(1)) <= tol;
+  }
+};
+
+}  // namespace bireg
