@@ -37,6 +37,7 @@ struct Rn {
 
   static AdMatrix ad(const Tangent& /*x*/) { return AdMatrix::Zero(); }
   static AdMatrix Ad(const Element& /*g*/) { return AdMatrix::Identity(); }
+  static Scalar ad_spectral_radius(const Tangent& /*x*/) { return Scalar(0); }
 
   static bool is_element(const Element& g, Scalar /*tol*/ = Scalar(0)) { return g.allFinite(); }
 };

@@ -99,6 +99,12 @@ struct SE2 {
     return m;
   }
 
+  // ad_x has eigenvalues 0 and +-i theta.
+  static Scalar ad_spectral_radius(const Tangent& x) {
+    using std::abs;
+    return abs(x[2]);
+  }
+
   // g hat(x) g^{-1} = hat(R rho - theta J t, theta): Ad_g = [R  -J t; 0 1].
   static AdMatrix Ad(const Element& g) {
     AdMatrix m = AdMatrix::Zero();

@@ -106,6 +106,12 @@ struct SE3 {
     return m;
   }
 
+  // ad_xi is block triangular with hat(omega) twice on the diagonal: its
+  // eigenvalues are 0 and +-i|omega|, each twice.
+  static Scalar ad_spectral_radius(const Tangent& xi) {
+    return Rotation::ad_spectral_radius(xi.template tail<3>());
+  }
+
   // g hat(xi) g^{-1} = hat(R rho + t x (R omega), R omega):
   // Ad_g = [R hat(t) R; 0 R].
   static AdMatrix Ad(const Element& g) {

@@ -54,6 +54,7 @@ struct SO2 {
 
   static AdMatrix ad(const Tangent& /*x*/) { return AdMatrix::Zero(); }
   static AdMatrix Ad(const Element& /*g*/) { return AdMatrix::Identity(); }
+  static Scalar ad_spectral_radius(const Tangent& /*x*/) { return Scalar(0); }
 
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {

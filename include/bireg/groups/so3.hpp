@@ -111,6 +111,12 @@ struct SO3 {
   static AdMatrix ad(const Tangent& omega) { return hat(omega); }
   static AdMatrix Ad(const Element& r) { return r; }
 
+  // ad_omega has eigenvalues 0 and +-i|omega|.
+  static Scalar ad_spectral_radius(const Tangent& omega) {
+    using std::sqrt;
+    return sqrt(omega.squaredNorm());
+  }
+
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.
   static bool is_element(const Element& r, Scalar tol = default_element_tolerance<Scalar>()) {
     using std::abs;

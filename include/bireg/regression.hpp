@@ -1,0 +1,545 @@
+// bireg: bi-invariant geodesic regression (Hanik & von Tycowicz, "Bi-invariant
+// Geodesic Regression: Existence, Uniqueness, and Convergence", Sections 2–4).
+//
+// Data (f_i, t_i), i = 1..N, f_i in a Lie group G, t_i real. The model is the
+// Cartan–Schouten geodesic gamma(t; g0, g1) = g0 exp(t log(g0^{-1} g1))
+// (paper, eq. "geodesic"), and the bi-invariant estimator is the pair of
+// endpoints at which the "net force" vanishes (Definition
+// "bi_inv_estiamtor", eqs. "bir1"/"bir2"):
+//
+//   v0 = sum_i w_i (1 - t_i)^2 (d_0 gamma_{t_i})^{-1} Log_{b_i}(f_i) = 0,
+//   v1 = sum_i w_i t_i^2       (d_1 gamma_{t_i})^{-1} Log_{b_i}(f_i) = 0,
+//
+// b_i = gamma(t_i; g0, g1) the model's prediction (w_i = 1 in the paper;
+// bireg allows per-observation weights). In left-trivialised coordinates
+// (DESIGN.md section 2), with X = log(g0^{-1} g1), A = ad_X and residuals
+// r_i = log(b_i^{-1} f_i),
+//
+//   v0 = sum_i w_i psi_{1 - t_i}(-A) r_i,   v1 = sum_i w_i psi_{t_i}(A) r_i,
+//
+// where psi_s is the series of Lemma "diff_2_gam" / Corollary "diff_1_gam"
+// (core/inverse_differential.hpp).
+//
+// The estimator is computed by the paper's iteration (eq. "algorithm"),
+//
+//   g0 <- g0 exp(lambda v0),   g1 <- g1 exp(lambda v1),
+//
+// which is equivariant under left and right translations and inversion of
+// the data (Proposition "equivariance_algorithm"). Near the solution it
+// behaves like its linear part I - lambda (H kron I) (Lemma "Psi_alt"), with
+//
+//   H = [a b; b c],  a = sum w_i (1 - t_i)^2,  b = sum w_i t_i (1 - t_i),  c = sum w_i t_i^2,
+//
+// and converges linearly, ||x_n - x^|| <= (1 - lambda eta)^n ||x_0 - x^||,
+// eta -> mu_min(H) as the data concentrate (Theorem "existance_and_uniquness").
+//
+// Covariates are mapped affinely onto [0, 1] (t_min -> 0, t_max -> 1); H,
+// mu_min, mu_max and lambda refer to that unit interval.
+//
+// Errors: fit() never throws for bad input or numerical failure and never
+// returns NaN. Invalid input is reported as Status::invalid_input with a
+// message naming the problem (and `bad_index`, the observation, where there
+// is one), before any iteration; a fit that does not converge reports
+// max_iterations, diverged or series_diverged and returns the last finite
+// iterate. Code built with -fno-exceptions is therefore served as is; the
+// only exception that can escape is std::bad_alloc from the result's
+// vectors (which such builds turn into termination).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "bireg/core/concept.hpp"
+#include "bireg/core/inverse_differential.hpp"
+#include "bireg/geodesic.hpp"
+#include "bireg/groups/tolerance.hpp"
+
+namespace bireg {
+
+enum class Status {
+  converged,        // step norm at or below the tolerance
+  max_iterations,   // iteration limit reached first; the last iterate is returned
+  diverged,         // the steps grew without bound (or became non-finite)
+  series_diverged,  // spectral radius of ad_X reached 2 pi: the inverse
+                    // differentials' series no longer converges
+  invalid_input,    // rejected before any work; see Result::message
+};
+
+inline const char* to_string(Status status) {
+  switch (status) {
+    case Status::converged:
+      return "converged";
+    case Status::max_iterations:
+      return "max_iterations";
+    case Status::diverged:
+      return "diverged";
+    case Status::series_diverged:
+      return "series_diverged";
+    case Status::invalid_input:
+      return "invalid_input";
+  }
+  return "unknown";
+}
+
+template <class G>
+class GeodesicRegression {
+  static_assert(check_lie_group<G>());
+
+ public:
+  using Scalar = typename G::Scalar;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+
+  struct Options {
+    // Truncation order M of the inverse-differential series: 0 chooses it
+    // adaptively at every iteration (the smallest M whose omitted terms are
+    // below epsilon relative, see adaptive_series_order), capped at
+    // max_series_order; M >= 1 fixes it.
+    int series_order = 0;
+    int max_series_order = kMaxSeriesOrder;
+    // lambda; 0 selects the paper's 1/mu_max. Must be below 2/mu_max, where
+    // the linear part stops contracting.
+    Scalar step_size = Scalar(0);
+    // Converged when the norm of the step (lambda v0, lambda v1), in
+    // tangent coordinates, is at or below this.
+    Scalar tolerance = std::max(Scalar(1e-10), Scalar(64) * std::numeric_limits<Scalar>::epsilon());
+    int max_iterations = 1000;
+    // Endpoints at the smallest and largest covariate to start from; by
+    // default the linearised least-squares fit described at initial_guess().
+    std::optional<std::pair<Element, Element>> initial_guess;
+    // Non-negative weight per observation; empty means all 1.
+    std::vector<Scalar> weights;
+    // Tolerance of the group-membership check on every observation.
+    Scalar element_tolerance = default_element_tolerance<Scalar>();
+    // Keep (g0, g1) after every step in Result::iterates.
+    bool record_iterates = false;
+  };
+
+  struct Diagnostics {
+    Scalar mu_min = 0;  // eigenvalues of H (unit covariate interval)
+    Scalar mu_max = 0;
+    Scalar step_size = 0;  // lambda used
+    // Ratio of the last two step norms: the observed linear rate, which the
+    // theory bounds by 1 - lambda eta (and by max|1 - lambda mu| for
+    // commutative groups).
+    Scalar contraction_factor = 0;
+    int series_order = 0;                // order used in the last iteration
+    Scalar series_truncation_bound = 0;  // relative size of the omitted terms
+    Scalar force_norm = 0;               // ||(v0, v1)|| at the returned endpoints
+    // sqrt(sum w_i |r_i|^2 / sum w_i), residuals about the fitted geodesic,
+    // and the same about the constant model (the data's bi-invariant mean).
+    Scalar residual_rms = 0;
+    Scalar residual_rms_about_mean = 0;
+    // 1 - residual_rms^2 / residual_rms_about_mean^2: the share of the
+    // data's spread about its bi-invariant mean that the geodesic explains.
+    // On R^n it is the ordinary R^2. Norms are Euclidean in the tangent
+    // coordinates (which mix units on SE(3)); 1 when the data do not spread.
+    Scalar explained_variance = 0;
+  };
+
+  struct Result {
+    Status status = Status::invalid_input;
+    std::string message;             // what was wrong, for invalid_input
+    std::ptrdiff_t bad_index = -1;   // offending observation, if any
+    Geodesic<G> geodesic;            // in the user's covariate units
+    int iterations = 0;              // steps taken
+    std::vector<Scalar> step_norms;  // norm of every step taken
+    std::vector<Tangent> residuals;  // r_i = log(gamma(t_i)^{-1} f_i), input order
+    std::vector<std::pair<Element, Element>> iterates;  // if Options::record_iterates
+    Diagnostics diagnostics;
+
+    bool ok() const { return status == Status::converged; }
+  };
+
+  GeodesicRegression() = default;
+  explicit GeodesicRegression(Options options) : options_(std::move(options)) {}
+  const Options& options() const { return options_; }
+
+  // Fits the geodesic to observations[i] at covariates[i]. Both are any
+  // indexable containers with size() (std::vector, std::deque, ...) of
+  // Element and of numbers; the order of the observations does not matter.
+  template <class Observations, class Covariates>
+  Result fit(const Observations& observations, const Covariates& covariates) const {
+    Result result;
+    Problem problem;
+    if (!prepare(observations, covariates, problem, result)) return result;
+
+    result.diagnostics.mu_min = problem.mu_min;
+    result.diagnostics.mu_max = problem.mu_max;
+    result.diagnostics.step_size = problem.lambda;
+
+    Element g0, g1;
+    if (options_.initial_guess) {
+      g0 = options_.initial_guess->first;
+      g1 = options_.initial_guess->second;
+    } else {
+      std::tie(g0, g1) = initial_guess(observations, problem);
+    }
+    iterate(observations, problem, g0, g1, result);
+    finish(observations, problem, g0, g1, result);
+    return result;
+  }
+
+ private:
+  // The normalised data the iteration needs, built once per fit.
+  struct Problem {
+    std::vector<Scalar> t;  // covariates mapped onto [0, 1]
+    std::vector<Scalar> w;  // weights
+    Scalar t_min = 0, t_max = 1;
+    Scalar a = 0, b = 0, c = 0;  // entries of H
+    Scalar mu_min = 0, mu_max = 0;
+    Scalar lambda = 0;
+    Scalar weight_sum = 0;
+  };
+
+  // The net force (v0, v1) and, optionally, the residuals.
+  struct Force {
+    Tangent v0, v1;
+    Scalar norm() const {
+      using std::sqrt;
+      return sqrt(v0.squaredNorm() + v1.squaredNorm());
+    }
+  };
+
+  static bool reject(Result& result, std::string message, std::ptrdiff_t index = -1) {
+    result.status = Status::invalid_input;
+    result.message = std::move(message);
+    result.bad_index = index;
+    return false;
+  }
+
+  static bool finite(Scalar x) {
+    using std::isfinite;
+    return isfinite(x);
+  }
+
+  // Validates everything before any work and fills `problem`.
+  template <class Observations, class Covariates>
+  bool prepare(const Observations& observations, const Covariates& covariates, Problem& problem,
+               Result& result) const {
+    using std::sqrt;
+    const std::size_t n = observations.size();
+    if (covariates.size() != n) {
+      return reject(result, "observations and covariates differ in length (" + std::to_string(n) +
+                                " vs " + std::to_string(covariates.size()) + ")");
+    }
+    if (n < 2) {
+      return reject(result, "need at least 2 observations, got " + std::to_string(n));
+    }
+    if (!options_.weights.empty() && options_.weights.size() != n) {
+      return reject(result, "weights and observations differ in length (" +
+                                std::to_string(options_.weights.size()) + " vs " +
+                                std::to_string(n) + ")");
+    }
+    if (!(options_.tolerance >= 0) || !finite(options_.tolerance)) {
+      return reject(result, "tolerance must be a finite non-negative number");
+    }
+    if (options_.max_iterations < 1) return reject(result, "max_iterations must be at least 1");
+    if (options_.max_series_order < 1 || options_.max_series_order > kMaxSeriesOrder) {
+      return reject(result,
+                    "max_series_order must be in [1, " + std::to_string(kMaxSeriesOrder) + "]");
+    }
+    if (options_.series_order < 0 || options_.series_order > kMaxSeriesOrder) {
+      return reject(result, "series_order must be 0 (adaptive) or in [1, " +
+                                std::to_string(kMaxSeriesOrder) + "]");
+    }
+    if (!(options_.step_size >= 0) || !finite(options_.step_size)) {
+      return reject(result, "step_size must be a finite non-negative number (0 = 1/mu_max)");
+    }
+
+    problem.t.resize(n);
+    problem.w.assign(n, Scalar(1));
+    for (std::size_t i = 0; i < n; ++i) {
+      const Scalar t = static_cast<Scalar>(covariates[i]);
+      if (!finite(t)) {
+        return reject(result, "covariate " + std::to_string(i) + " is not finite", index(i));
+      }
+      problem.t[i] = t;
+      if (!options_.weights.empty()) {
+        const Scalar w = options_.weights[i];
+        if (!(w >= 0) || !finite(w)) {
+          return reject(result, "weight " + std::to_string(i) + " is negative or not finite",
+                        index(i));
+        }
+        problem.w[i] = w;
+      }
+      const Element& f = observations[i];
+      if (!f.allFinite()) {
+        return reject(result, "observation " + std::to_string(i) + " has non-finite entries",
+                      index(i));
+      }
+      if (!G::is_element(f, options_.element_tolerance)) {
+        return reject(result,
+                      "observation " + std::to_string(i) + " is not an element of " + G::name +
+                          " (to tolerance " + std::to_string(double(options_.element_tolerance)) +
+                          ")",
+                      index(i));
+      }
+    }
+
+    // Affine map onto [0, 1] (DESIGN.md section 1).
+    const auto [min_it, max_it] = std::minmax_element(problem.t.begin(), problem.t.end());
+    problem.t_min = *min_it;
+    problem.t_max = *max_it;
+    const Scalar range = problem.t_max - problem.t_min;
+    if (!(range > 0) || !finite(range)) {
+      return reject(result, range > 0 ? "covariate range overflows"
+                                      : "all covariates are equal: the slope is not identifiable");
+    }
+    for (Scalar& t : problem.t)
+      t = std::clamp((t - problem.t_min) / range, Scalar(0), Scalar(1));
+
+    // H of Lemma "Psi_alt", and its eigenvalues in a cancellation-free form.
+    for (std::size_t i = 0; i < n; ++i) {
+      const Scalar t = problem.t[i], w = problem.w[i];
+      problem.a += w * (1 - t) * (1 - t);
+      problem.b += w * t * (1 - t);
+      problem.c += w * t * t;
+      problem.weight_sum += w;
+    }
+    const Scalar half_trace = (problem.a + problem.c) / 2;
+    const Scalar half_gap = (problem.a - problem.c) / 2;
+    problem.mu_max = half_trace + sqrt(half_gap * half_gap + problem.b * problem.b);
+    const Scalar determinant = problem.a * problem.c - problem.b * problem.b;
+    problem.mu_min = problem.mu_max > 0 ? determinant / problem.mu_max : Scalar(0);
+    // mu_min is computed to ~eps mu_max; below a few of those it is noise.
+    if (!(problem.mu_min > 16 * std::numeric_limits<Scalar>::epsilon() * problem.mu_max)) {
+      return reject(result,
+                    "the observations with positive weight share one covariate: the slope is not "
+                    "identifiable (mu_min = 0)");
+    }
+
+    const Scalar lambda_limit = 2 / problem.mu_max;
+    problem.lambda = options_.step_size > 0 ? options_.step_size : 1 / problem.mu_max;
+    if (!(problem.lambda < lambda_limit)) {
+      return reject(result,
+                    "step_size " + std::to_string(double(problem.lambda)) +
+                        " is at or above 2/mu_max = " + std::to_string(double(lambda_limit)) +
+                        ": the linear part of the iteration no longer contracts");
+    }
+
+    if (options_.initial_guess) {
+      if (!G::is_element(options_.initial_guess->first, options_.element_tolerance) ||
+          !G::is_element(options_.initial_guess->second, options_.element_tolerance)) {
+        return reject(result, std::string("initial_guess is not a pair of elements of ") + G::name);
+      }
+    }
+    return true;
+  }
+
+  static std::ptrdiff_t index(std::size_t i) { return static_cast<std::ptrdiff_t>(i); }
+
+  // Default start: the weighted least-squares line through the data in the
+  // log chart at f_ref, the observation nearest the middle of the covariate
+  // range, y_i = log(f_ref^{-1} f_i) ~ (1 - t_i) x0 + t_i x1, i.e.
+  // (x0, x1) = (H^{-1} kron I) (sum w (1-t) y, sum w t y), and
+  // (g0, g1) = (f_ref exp(x0), f_ref exp(x1)). It is exact on commutative
+  // groups, first-order accurate otherwise, and, like the iteration,
+  // equivariant under left and right translation and inversion (the chart
+  // moves with f_ref), so the whole fit stays equivariant. The middle
+  // observation keeps the chart's distortion smallest for the endpoints.
+  template <class Observations>
+  std::pair<Element, Element> initial_guess(const Observations& observations,
+                                            const Problem& problem) const {
+    const std::size_t n = observations.size();
+    std::size_t reference = 0;
+    for (std::size_t i = 1; i < n; ++i) {
+      using std::abs;
+      if (abs(problem.t[i] - Scalar(0.5)) < abs(problem.t[reference] - Scalar(0.5))) reference = i;
+    }
+    const Element& f_ref = observations[reference];
+    const Element f_ref_inverse = G::inverse(f_ref);
+    Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
+      moment0 += problem.w[i] * (1 - problem.t[i]) * y;
+      moment1 += problem.w[i] * problem.t[i] * y;
+    }
+    const Scalar determinant = problem.a * problem.c - problem.b * problem.b;
+    const Tangent x0 = (problem.c * moment0 - problem.b * moment1) / determinant;
+    const Tangent x1 = (problem.a * moment1 - problem.b * moment0) / determinant;
+    return {exp_at<G>(f_ref, x0), exp_at<G>(f_ref, x1)};
+  }
+
+  // The net force of eq. "v" at (g0, g1), x = log(g0^{-1} g1), a = ad_x.
+  //
+  // Moment form: psi_s(z) = sum_m (-1)^m sum_k T[m][k] s^{k+1} z^m, and A is
+  // the same for every observation, so
+  //   v1 = sum_m (-A)^m u_m,  u_m = sum_k T[m][k] P_{k+1},  P_j = sum_i w_i t_i^j r_i,
+  //   v0 = sum_m   A^m z_m,   z_m = sum_k T[m][k] Q_{k+1},  Q_j = sum_i w_i (1 - t_i)^j r_i
+  // (psi_{1-t}(-A) flips the sign of z and of (-1)^m together). Each
+  // observation then costs one exp, one log, two compositions and
+  // 2 (M + 1) vector updates; the M matrix-vector products of Horner's rule
+  // are paid once per iteration, not once per observation.
+  template <class Observations>
+  Force net_force(const Observations& observations, const Problem& problem, const Element& g0,
+                  const Tangent& x, const AdMatrix& a, int order,
+                  std::vector<Tangent>* residuals = nullptr) const {
+    std::array<Tangent, kMaxSeriesOrder + 2> p, q;  // P_j, Q_j for j = 1 .. order + 1
+    for (int j = 1; j <= order + 1; ++j) {
+      p[j].setZero();
+      q[j].setZero();
+    }
+    const Element g0_inverse = G::inverse(g0);
+    const std::size_t n = observations.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Scalar t = problem.t[i];
+      // r_i = log(b_i^{-1} f_i), b_i^{-1} = exp(-t_i X) g0^{-1}.
+      const Tangent r = G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, observations[i])));
+      if (residuals) (*residuals)[i] = r;
+      Scalar t_power = problem.w[i];
+      Scalar one_minus_t_power = problem.w[i];
+      for (int j = 1; j <= order + 1; ++j) {
+        t_power *= t;
+        one_minus_t_power *= 1 - t;
+        p[j] += t_power * r;
+        q[j] += one_minus_t_power * r;
+      }
+    }
+    const auto series_term = [&](const std::array<Tangent, kMaxSeriesOrder + 2>& moments, int m) {
+      Tangent term = Tangent::Zero();
+      for (int k = 0; k <= m; ++k)
+        term += static_cast<Scalar>(kPsiSeriesTable[m][k]) * moments[k + 1];
+      return term;
+    };
+    Force force{series_term(q, order), series_term(p, order)};
+    for (int m = order - 1; m >= 0; --m) {  // Horner's rule
+      force.v0 = a * force.v0 + series_term(q, m);
+      force.v1 = -(a * force.v1) + series_term(p, m);
+    }
+    return force;
+  }
+
+  // The series order for the current X (fixed or adaptive).
+  std::pair<int, Scalar> series_order(const AdMatrix& a) const {
+    if (options_.series_order > 0) return {options_.series_order, Scalar(0)};
+    return adaptive_series_order(a, std::numeric_limits<Scalar>::epsilon(),
+                                 options_.max_series_order);
+  }
+
+  // The paper's iteration (eq. "algorithm"): g0 <- g0 exp(lambda v0),
+  // g1 <- g1 exp(lambda v1), until the step is below the tolerance. No heap
+  // allocation happens inside the loop (the history is reserved up front).
+  template <class Observations>
+  void iterate(const Observations& observations, const Problem& problem, Element& g0, Element& g1,
+               Result& result) const {
+    using std::isfinite;
+    constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
+    // A step this much larger than the smallest one seen, and not at the
+    // rounding level of the tolerance, means the iteration left the basin
+    // where it contracts.
+    constexpr Scalar kDivergenceGrowth = Scalar(1e3);
+
+    result.step_norms.reserve(static_cast<std::size_t>(options_.max_iterations));
+    if (options_.record_iterates) {
+      result.iterates.reserve(static_cast<std::size_t>(options_.max_iterations));
+    }
+    result.status = Status::max_iterations;
+    Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
+    for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+      const Tangent x = log_at<G>(g0, g1);
+      if (!(ad_spectral_radius<G>(x) < kTwoPi)) {
+        result.status = Status::series_diverged;
+        return;
+      }
+      const AdMatrix a = G::ad(x);
+      const auto [order, truncation] = series_order(a);
+      result.diagnostics.series_order = order;
+      result.diagnostics.series_truncation_bound = truncation;
+
+      const Force force = net_force(observations, problem, g0, x, a, order);
+      const Tangent step0 = problem.lambda * force.v0;
+      const Tangent step1 = problem.lambda * force.v1;
+      const Scalar step_norm = problem.lambda * force.norm();
+      if (!isfinite(step_norm) || (step_norm > kDivergenceGrowth * smallest_step &&
+                                   step_norm > kDivergenceGrowth * options_.tolerance)) {
+        result.status = Status::diverged;
+        return;
+      }
+      smallest_step = std::min(smallest_step, step_norm);
+
+      g0 = exp_at<G>(g0, step0);
+      g1 = exp_at<G>(g1, step1);
+      result.step_norms.push_back(step_norm);
+      result.iterations = iteration + 1;
+      if (options_.record_iterates) result.iterates.emplace_back(g0, g1);
+      if (step_norm <= options_.tolerance) {
+        result.status = Status::converged;
+        return;
+      }
+    }
+  }
+
+  // Residuals, the force at the returned endpoints, and the diagnostics.
+  template <class Observations>
+  void finish(const Observations& observations, const Problem& problem, const Element& g0,
+              const Element& g1, Result& result) const {
+    using std::sqrt;
+    const std::size_t n = observations.size();
+    result.geodesic = Geodesic<G>(g0, g1, problem.t_min, problem.t_max);
+    result.residuals.resize(n);
+    const Tangent x = log_at<G>(g0, g1);
+    const AdMatrix a = G::ad(x);
+    const int order = series_order(a).first;
+    const Force force = net_force(observations, problem, g0, x, a, order, &result.residuals);
+
+    Diagnostics& d = result.diagnostics;
+    d.force_norm = force.norm();
+    const std::size_t steps = result.step_norms.size();
+    if (steps >= 2 && result.step_norms[steps - 2] > 0) {
+      d.contraction_factor = result.step_norms[steps - 1] / result.step_norms[steps - 2];
+    }
+    Scalar residual_sum = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      residual_sum += problem.w[i] * result.residuals[i].squaredNorm();
+    d.residual_rms = sqrt(residual_sum / problem.weight_sum);
+    const Scalar spread_sum = spread_about_mean(observations, problem, result.geodesic);
+    d.residual_rms_about_mean = sqrt(spread_sum / problem.weight_sum);
+    d.explained_variance = spread_sum > 0 ? 1 - residual_sum / spread_sum : Scalar(1);
+  }
+
+  // sum w_i |log(m^{-1} f_i)|^2 about the data's bi-invariant (exponential)
+  // mean m, the fixed point of m <- m exp(sum w log(m^{-1} f) / sum w) (the
+  // constant-geodesic case of the same estimator), started at the fitted
+  // geodesic's point at the weighted mean covariate.
+  template <class Observations>
+  Scalar spread_about_mean(const Observations& observations, const Problem& problem,
+                           const Geodesic<G>& geodesic) const {
+    const std::size_t n = observations.size();
+    Scalar mean_t = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      mean_t += problem.w[i] * problem.t[i];
+    mean_t /= problem.weight_sum;
+    Element mean = exp_at<G>(geodesic.start(), mean_t * geodesic.displacement());
+    constexpr int kMeanIterations = 100;
+    for (int iteration = 0; iteration < kMeanIterations; ++iteration) {
+      const Element mean_inverse = G::inverse(mean);
+      Tangent step = Tangent::Zero();
+      for (std::size_t i = 0; i < n; ++i) {
+        step += problem.w[i] * G::log(G::compose(mean_inverse, observations[i]));
+      }
+      step /= problem.weight_sum;
+      mean = exp_at<G>(mean, step);
+      if (!(step.norm() > options_.tolerance)) break;
+    }
+    const Element mean_inverse = G::inverse(mean);
+    Scalar sum = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      sum += problem.w[i] * G::log(G::compose(mean_inverse, observations[i])).squaredNorm();
+    }
+    return sum;
+  }
+
+  Options options_;
+};
+
+}  // namespace bireg
