@@ -1,0 +1,214 @@
+// bireg_fit: fit a bi-invariant geodesic to a trajectory file.
+//
+//   bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum] [--method series|series_adaptive]
+//             [--order M] [--solver paper] [--step LAMBDA] [--tol X] [--max-iter K]
+//             [--output-trajectory FILE] FILE|-
+//
+// The long spellings of the library's option names are accepted as well:
+// --series-order, --step-size, --tolerance, --max-iterations.
+//
+// Prints one JSON object on stdout. Exit codes: 0 converged, 2 invalid input
+// or usage (one line on stderr naming file, line and problem), 3 the fit did
+// not converge (the JSON is still printed, with its status).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bireg/groups/se2.hpp"
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/so2.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/regression.hpp"
+#include "bireg/tools/trajectory_io.hpp"
+
+namespace {
+
+constexpr int kExitInvalid = 2;
+constexpr int kExitNotConverged = 3;
+
+constexpr const char* kUsage =
+    "usage: bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum]\n"
+    "                 [--method series|series_adaptive] [--order M] [--solver paper]\n"
+    "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
+    "                 [--output-trajectory FILE] FILE|-\n";
+
+struct Command {
+  std::string group;
+  bireg::tools::Format format = bireg::tools::Format::matrix;
+  std::string method = "series_adaptive";
+  int order = 0;
+  double step = 0;
+  std::optional<double> tolerance;
+  int max_iterations = 1000;
+  std::string output_trajectory;
+  std::string input;
+};
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "bireg_fit: %s\n", message.c_str());
+  return kExitInvalid;
+}
+
+bool parse_number(const std::string& text, double& value) {
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+bool parse_count(const std::string& text, int& value) {
+  double x = 0;
+  if (!parse_number(text, x) || x != std::floor(x) || x < 0 || x > 1e9) return false;
+  value = static_cast<int>(x);
+  return true;
+}
+
+// Parses argv into `command`; returns an error message or nothing.
+std::optional<std::string> parse_command(int argc, char** argv, Command& command) {
+  bool order_given = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const auto value = [&]() -> std::optional<std::string> {
+      if (i + 1 >= argc) return std::nullopt;
+      return std::string(argv[++i]);
+    };
+    if (arg == "-" || arg.empty() || arg[0] != '-') {
+      if (!command.input.empty()) return "more than one input file";
+      command.input = arg;
+      continue;
+    }
+    const std::optional<std::string> v = value();
+    if (!v) return "option " + arg + " needs a value";
+    if (arg == "--group") {
+      command.group = *v;
+    } else if (arg == "--format") {
+      if (*v == "matrix") {
+        command.format = bireg::tools::Format::matrix;
+      } else if (*v == "tum") {
+        command.format = bireg::tools::Format::tum;
+      } else {
+        return "unknown format '" + *v + "' (matrix or tum)";
+      }
+    } else if (arg == "--method") {
+      if (*v != "series" && *v != "series_adaptive") {
+        return "unknown method '" + *v + "' (series or series_adaptive)";
+      }
+      command.method = *v;
+    } else if (arg == "--order" || arg == "--series-order") {
+      if (!parse_count(*v, command.order) || command.order < 1 ||
+          command.order > bireg::kMaxSeriesOrder) {
+        return "--order needs an integer in [1, " + std::to_string(bireg::kMaxSeriesOrder) + "]";
+      }
+      order_given = true;
+    } else if (arg == "--solver") {
+      if (*v != "paper") return "unknown solver '" + *v + "' (paper)";
+    } else if (arg == "--step" || arg == "--step-size") {
+      if (!parse_number(*v, command.step) || command.step <= 0) {
+        return "--step needs a positive number";
+      }
+    } else if (arg == "--tol" || arg == "--tolerance") {
+      double tol = 0;
+      if (!parse_number(*v, tol) || tol < 0) return "--tol needs a non-negative number";
+      command.tolerance = tol;
+    } else if (arg == "--max-iter" || arg == "--max-iterations") {
+      if (!parse_count(*v, command.max_iterations) || command.max_iterations < 1) {
+        return "--max-iter needs a positive integer";
+      }
+    } else if (arg == "--output-trajectory") {
+      command.output_trajectory = *v;
+    } else {
+      return "unknown option " + arg;
+    }
+  }
+  if (command.group.empty()) return "--group is required";
+  if (command.input.empty()) return "no input file (use - for standard input)";
+  if (command.method == "series" && !order_given) return "--method series needs --order M";
+  if (command.method == "series_adaptive" && order_given) command.method = "series";
+  return std::nullopt;
+}
+
+std::string json_number(double x) {
+  return std::isfinite(x) ? bireg::tools::format_double(x) : std::string("null");
+}
+
+template <class G>
+int run(const Command& command) {
+  using Regression = bireg::GeodesicRegression<G>;
+  const std::string name = command.input == "-" ? "<stdin>" : command.input;
+  std::ifstream file;
+  if (command.input != "-") {
+    file.open(command.input);
+    if (!file) return fail(name + ": cannot open file");
+  }
+  std::istream& in = command.input == "-" ? std::cin : file;
+
+  bireg::tools::Trajectory<G> trajectory;
+  if (const auto error = bireg::tools::read_trajectory<G>(in, command.format, trajectory)) {
+    const std::string where = error->line > 0 ? name + ":" + std::to_string(error->line) : name;
+    return fail(where + ": " + error->message);
+  }
+
+  typename Regression::Options options;
+  options.series_order = command.method == "series" ? command.order : 0;
+  options.step_size = command.step;
+  if (command.tolerance) options.tolerance = *command.tolerance;
+  options.max_iterations = command.max_iterations;
+  const auto result = Regression(options).fit(trajectory.observations, trajectory.covariates);
+  if (result.status == bireg::Status::invalid_input) {
+    const std::string where =
+        result.bad_index >= 0
+            ? name + ":" +
+                  std::to_string(trajectory.lines[static_cast<std::size_t>(result.bad_index)])
+            : name;
+    return fail(where + ": " + result.message);
+  }
+
+  const auto& d = result.diagnostics;
+  const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
+  std::printf(
+      "{\"group\": \"%s\", \"n\": %zu,\n \"g0\": %s,\n \"g1\": %s,\n \"t_min\": %s, \"t_max\": "
+      "%s,\n"
+      " \"status\": \"%s\", \"iterations\": %d, \"final_step_norm\": %s,\n"
+      " \"diagnostics\": {\"mu_min\": %s, \"mu_max\": %s, \"step_size\": %s, "
+      "\"contraction_factor\": %s, \"series_order\": %d, \"force_norm\": %s, "
+      "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
+      G::name, trajectory.observations.size(),
+      bireg::tools::json_matrix(result.geodesic.start()).c_str(),
+      bireg::tools::json_matrix(result.geodesic.end()).c_str(),
+      json_number(result.geodesic.t_min()).c_str(), json_number(result.geodesic.t_max()).c_str(),
+      bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
+      json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
+      json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(), d.series_order,
+      json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
+      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
+
+  if (!command.output_trajectory.empty()) {
+    std::ofstream out(command.output_trajectory);
+    if (!out) return fail(command.output_trajectory + ": cannot write file");
+    for (double t : trajectory.covariates) {
+      out << bireg::tools::format_observation<G>(command.format, t, result.geodesic(t)) << '\n';
+    }
+  }
+  return result.ok() ? 0 : kExitNotConverged;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Command command;
+  if (const auto error = parse_command(argc, argv, command)) {
+    std::fprintf(stderr, "bireg_fit: %s\n%s", error->c_str(), kUsage);
+    return kExitInvalid;
+  }
+  if (command.group == "SO2") return run<bireg::SO2<double>>(command);
+  if (command.group == "SO3") return run<bireg::SO3<double>>(command);
+  if (command.group == "SE2") return run<bireg::SE2<double>>(command);
+  if (command.group == "SE3") return run<bireg::SE3<double>>(command);
+  std::fprintf(stderr, "bireg_fit: unknown group '%s' (SO2, SO3, SE2 or SE3)\n%s",
+               command.group.c_str(), kUsage);
+  return kExitInvalid;
+}
