@@ -1,7 +1,8 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
 //   bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum] [--method series|series_adaptive]
-//             [--order M] [--solver paper] [--step LAMBDA] [--tol X] [--max-iter K]
+//             [--order M] [--solver paper|optimal_linear|preconditioned|gauss_newton]
+//             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--output-trajectory FILE] FILE|-
 //
 // The long spellings of the library's option names are accepted as well:
@@ -33,7 +34,8 @@ constexpr int kExitNotConverged = 3;
 
 constexpr const char* kUsage =
     "usage: bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum]\n"
-    "                 [--method series|series_adaptive] [--order M] [--solver paper]\n"
+    "                 [--method series|series_adaptive] [--order M]\n"
+    "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
     "                 [--output-trajectory FILE] FILE|-\n";
 
@@ -42,6 +44,7 @@ struct Command {
   bireg::tools::Format format = bireg::tools::Format::matrix;
   std::string method = "series_adaptive";
   int order = 0;
+  bireg::Solver solver = bireg::Solver::gauss_newton;
   double step = 0;
   std::optional<double> tolerance;
   int max_iterations = 1000;
@@ -105,7 +108,17 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       }
       order_given = true;
     } else if (arg == "--solver") {
-      if (*v != "paper") return "unknown solver '" + *v + "' (paper)";
+      bool known = false;
+      for (bireg::Solver solver : {bireg::Solver::paper, bireg::Solver::optimal_linear,
+                                   bireg::Solver::preconditioned, bireg::Solver::gauss_newton}) {
+        if (*v == bireg::to_string(solver)) {
+          command.solver = solver;
+          known = true;
+        }
+      }
+      if (!known) {
+        return "unknown solver '" + *v + "' (paper, optimal_linear, preconditioned, gauss_newton)";
+      }
     } else if (arg == "--step" || arg == "--step-size") {
       if (!parse_number(*v, command.step) || command.step <= 0) {
         return "--step needs a positive number";
@@ -154,6 +167,7 @@ int run(const Command& command) {
 
   typename Regression::Options options;
   options.series_order = command.method == "series" ? command.order : 0;
+  options.solver = command.solver;
   options.step_size = command.step;
   if (command.tolerance) options.tolerance = *command.tolerance;
   options.max_iterations = command.max_iterations;
@@ -174,7 +188,8 @@ int run(const Command& command) {
       "%s,\n"
       " \"status\": \"%s\", \"iterations\": %d, \"final_step_norm\": %s,\n"
       " \"diagnostics\": {\"mu_min\": %s, \"mu_max\": %s, \"step_size\": %s, "
-      "\"contraction_factor\": %s, \"series_order\": %d, \"force_norm\": %s, "
+      "\"contraction_factor\": %s, \"series_order\": %d, \"solver\": \"%s\", \"backtracks\": %d, "
+      "\"force_norm\": %s, "
       "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
       G::name, trajectory.observations.size(),
       bireg::tools::json_matrix(result.geodesic.start()).c_str(),
@@ -183,8 +198,9 @@ int run(const Command& command) {
       bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
       json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
       json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(), d.series_order,
-      json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
-      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
+      bireg::to_string(command.solver), d.backtracks, json_number(d.force_norm).c_str(),
+      json_number(d.residual_rms).c_str(), json_number(d.residual_rms_about_mean).c_str(),
+      json_number(d.explained_variance).c_str());
 
   if (!command.output_trajectory.empty()) {
     std::ofstream out(command.output_trajectory);

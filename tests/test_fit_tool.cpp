@@ -202,7 +202,8 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
       {"--group SO3", "no_such_file.csv", "no_such_file.csv: cannot open file"},
       {"--group SO4", "so3_small.csv", "unknown group 'SO4'"},
       {"--group SO3 --tol -1", "so3_small.csv", "--tol needs a non-negative number"},
-      {"--group SO3 --step 100", "so3_small.csv", "no longer contracts"},
+      {"--group SO3 --solver paper --step 100", "so3_small.csv", "no longer contracts"},
+      {"--group SO3 --step 0.01", "so3_small.csv", "step_size applies to the paper solver only"},
       {"--group SO3 --method series", "so3_small.csv", "--method series needs --order M"},
       {"--group SO3 --order 0", "so3_small.csv", "--order needs an integer"},
       {"--group SO3 --solver newton", "so3_small.csv", "unknown solver 'newton'"},
@@ -220,7 +221,8 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
 
 TEST_CASE("bireg_fit exits with 3 and still prints the JSON when the fit does not converge",
           "[tool]") {
-  const Run run = run_tool("--group SO3 --max-iter 2 \"" + data("so3_small.csv") + "\"");
+  const Run run =
+      run_tool("--group SO3 --solver paper --max-iter 2 \"" + data("so3_small.csv") + "\"");
   REQUIRE(run.exit_code == 3);
   REQUIRE(json_string(run.out, "status") == "max_iterations");
   REQUIRE(json_numbers(run.out, "iterations").at(0) == 2);

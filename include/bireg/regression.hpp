@@ -57,6 +57,9 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+#include <Eigen/LU>
+
 #include "bireg/core/concept.hpp"
 #include "bireg/core/inverse_differential.hpp"
 #include "bireg/geodesic.hpp"
@@ -89,6 +92,39 @@ inline const char* to_string(Status status) {
   return "unknown";
 }
 
+// The step rule. All are Exp-stepped iterations g0 <- g0 exp(d0),
+// g1 <- g1 exp(d1) with the same fixed point v = 0, and all keep left, right
+// and inverse equivariance (tests/test_regression.cpp checks each, iterate
+// by iterate). Note: DESIGN.md's "Equivariant preconditioning" says any
+// constant 2x2 mixing of (v0, v1) keeps inverse equivariance; it does not
+// (v0 and v1 live in the frames of g0 and g1), see Solver::preconditioned.
+enum class Solver {
+  paper,           // (d0, d1) = lambda (v0, v1), lambda given or 1/mu_max (the paper's)
+  optimal_linear,  // lambda = 2/(mu_min + mu_max), minimising max|1 - lambda mu|
+  preconditioned,  // H^{-1} applied to (v0, v1), the coupling carried across by
+                   // Ad_exp(X/2): cancels the linear part
+  gauss_newton,    // (d0, d1) = K^{-1}(v0, v1), K the Jacobian of v at zero residual
+};
+
+inline const char* to_string(Solver solver) {
+  switch (solver) {
+    case Solver::paper:
+      return "paper";
+    case Solver::optimal_linear:
+      return "optimal_linear";
+    case Solver::preconditioned:
+      return "preconditioned";
+    case Solver::gauss_newton:
+      return "gauss_newton";
+  }
+  return "unknown";
+}
+
+// Truncation order of the power series that build Gauss-Newton's K. K only
+// shapes the step, not the fixed point, so it needs modest accuracy: at the
+// largest spectral radius (pi) the omitted terms are below 2^-24 ~ 6e-8.
+inline constexpr int kGaussNewtonOrder = 24;
+
 template <class G>
 class GeodesicRegression {
   static_assert(check_lie_group<G>());
@@ -106,8 +142,12 @@ class GeodesicRegression {
     // max_series_order; M >= 1 fixes it.
     int series_order = 0;
     int max_series_order = kMaxSeriesOrder;
-    // lambda; 0 selects the paper's 1/mu_max. Must be below 2/mu_max, where
-    // the linear part stops contracting.
+    // The step rule (see Solver). Gauss-Newton converges in a handful of
+    // iterations where the paper's step needs dozens.
+    Solver solver = Solver::gauss_newton;
+    // lambda of the paper solver; 0 selects the paper's 1/mu_max. Must be
+    // below 2/mu_max, where the linear part stops contracting. The other
+    // solvers fix their own step, so a non-zero value is refused for them.
     Scalar step_size = Scalar(0);
     // Converged when the norm of the step (lambda v0, lambda v1), in
     // tangent coordinates, is at or below this.
@@ -127,7 +167,10 @@ class GeodesicRegression {
   struct Diagnostics {
     Scalar mu_min = 0;  // eigenvalues of H (unit covariate interval)
     Scalar mu_max = 0;
-    Scalar step_size = 0;  // lambda used
+    Scalar step_size = 0;  // lambda used (1 for preconditioned and gauss_newton)
+    // Step halvings of the safeguard (every solver but paper): a step that
+    // would increase ||v|| is halved until it does not.
+    int backtracks = 0;
     // Ratio of the last two step norms: the observed linear rate, which the
     // theory bounds by 1 - lambda eta (and by max|1 - lambda mu| for
     // commutative groups).
@@ -199,6 +242,9 @@ class GeodesicRegression {
     Scalar mu_min = 0, mu_max = 0;
     Scalar lambda = 0;
     Scalar weight_sum = 0;
+    // Power-series coefficients of K's off-diagonal blocks (gauss_newton):
+    // K01 = sum_m k01[m] A^m, K10 = sum_m k10[m] A^m.
+    std::array<Scalar, kGaussNewtonOrder + 1> k01{}, k10{};
   };
 
   // The net force (v0, v1) and, optionally, the residuals.
@@ -318,14 +364,30 @@ class GeodesicRegression {
                     "identifiable (mu_min = 0)");
     }
 
+    if (options_.solver != Solver::paper && options_.step_size != 0) {
+      return reject(result, std::string("step_size applies to the paper solver only, not to ") +
+                                to_string(options_.solver));
+    }
     const Scalar lambda_limit = 2 / problem.mu_max;
-    problem.lambda = options_.step_size > 0 ? options_.step_size : 1 / problem.mu_max;
-    if (!(problem.lambda < lambda_limit)) {
+    switch (options_.solver) {
+      case Solver::paper:
+        problem.lambda = options_.step_size > 0 ? options_.step_size : 1 / problem.mu_max;
+        break;
+      case Solver::optimal_linear:
+        problem.lambda = 2 / (problem.mu_min + problem.mu_max);
+        break;
+      case Solver::preconditioned:
+      case Solver::gauss_newton:
+        problem.lambda = 1;
+        break;
+    }
+    if (options_.solver == Solver::paper && !(problem.lambda < lambda_limit)) {
       return reject(result,
                     "step_size " + std::to_string(double(problem.lambda)) +
                         " is at or above 2/mu_max = " + std::to_string(double(lambda_limit)) +
                         ": the linear part of the iteration no longer contracts");
     }
+    if (options_.solver == Solver::gauss_newton) gauss_newton_coefficients(problem);
 
     if (options_.initial_guess) {
       if (!G::is_element(options_.initial_guess->first, options_.element_tolerance) ||
@@ -337,6 +399,45 @@ class GeodesicRegression {
   }
 
   static std::ptrdiff_t index(std::size_t i) { return static_cast<std::ptrdiff_t>(i); }
+
+  // Coefficients of K's off-diagonal blocks (DESIGN.md section 2,
+  // "Equivariant Gauss-Newton"). With u = 1 - t,
+  //   K01 = sum_i w_i g_{t_i}(A),  g_t(z) = psi_{1-t}(-z) / phi_t(z)
+  //                                     = u t E(t z) B(-u z),
+  //   K10 = sum_i w_i g_{1-t_i}(-A),
+  // where E(w) = (e^w - 1)/w = sum_n w^n/(n+1)! and B(w) = w/(e^w - 1) =
+  // sum_k b_k w^k (the identity e^{uz} B(uz) = B(-uz) turns DESIGN.md's
+  // u^2 e^{uz} (e^{tz} - 1)/(e^{uz} - 1) into this product). Hence
+  //   [z^m] g_t = sum_{n+k=m} t^{n+1}/(n+1)! (-1)^k b_k u^{k+1},
+  // summed over the observations once per fit: O(kGaussNewtonOrder^2) per
+  // observation, and K then costs O(kGaussNewtonOrder d^3) per iteration,
+  // independent of N. At z = 0 both blocks reduce to b = sum w t (1 - t), so
+  // K = H kron I on commutative groups.
+  static void gauss_newton_coefficients(Problem& problem) {
+    constexpr int kOrder = kGaussNewtonOrder;
+    std::array<Scalar, kOrder + 2> t_power{}, u_power{};  // t^j, u^j for j = 0 .. kOrder + 1
+    for (std::size_t i = 0; i < problem.t.size(); ++i) {
+      const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
+      t_power[0] = u_power[0] = 1;
+      for (int j = 1; j <= kOrder + 1; ++j) {
+        t_power[j] = t_power[j - 1] * t;
+        u_power[j] = u_power[j - 1] * u;
+      }
+      for (int m = 0; m <= kOrder; ++m) {
+        Scalar start = 0, end = 0;  // [z^m] g_t and [z^m] g_{1-t}(-z), up to (-1)^m
+        for (int k = 0; k <= m; ++k) {
+          const int n = m - k;
+          // kPsiSeriesTable[m][k] = b_k / (m - k + 1)! = b_k / (n + 1)!
+          const Scalar coefficient = static_cast<Scalar>(kPsiSeriesTable[m][k]);
+          const Scalar signed_coefficient = k % 2 == 0 ? coefficient : -coefficient;
+          start += signed_coefficient * t_power[n + 1] * u_power[k + 1];
+          end += signed_coefficient * u_power[n + 1] * t_power[k + 1];
+        }
+        problem.k01[m] += w * start;
+        problem.k10[m] += w * (m % 2 == 0 ? end : -end);
+      }
+    }
+  }
 
   // Default start: the weighted least-squares line through the data in the
   // log chart at f_ref, the observation nearest the middle of the covariate
@@ -426,40 +527,128 @@ class GeodesicRegression {
                                  options_.max_series_order);
   }
 
-  // The paper's iteration (eq. "algorithm"): g0 <- g0 exp(lambda v0),
-  // g1 <- g1 exp(lambda v1), until the step is below the tolerance. No heap
-  // allocation happens inside the loop (the history is reserved up front).
+  // Everything the iteration needs at one pair of endpoints.
+  struct State {
+    Element g0, g1;
+    Tangent x;   // log(g0^{-1} g1)
+    AdMatrix a;  // ad_x
+    int order = 0;
+    Scalar truncation = 0;
+    Force force;
+    bool series_converges = true;  // spectral radius of ad_x below 2 pi
+  };
+
+  template <class Observations>
+  State evaluate(const Observations& observations, const Problem& problem, const Element& g0,
+                 const Element& g1) const {
+    constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
+    State state;
+    state.g0 = g0;
+    state.g1 = g1;
+    state.x = log_at<G>(g0, g1);
+    state.a = G::ad(state.x);
+    if (!(ad_spectral_radius<G>(state.x) < kTwoPi)) {
+      state.series_converges = false;
+      return state;
+    }
+    std::tie(state.order, state.truncation) = series_order(state.a);
+    state.force = net_force(observations, problem, g0, state.x, state.a, state.order);
+    return state;
+  }
+
+  // The full step (d0, d1) of the chosen solver at `state`.
+  std::pair<Tangent, Tangent> step(const Problem& problem, const State& state) const {
+    const Tangent& v0 = state.force.v0;
+    const Tangent& v1 = state.force.v1;
+    switch (options_.solver) {
+      case Solver::paper:
+      case Solver::optimal_linear:
+        return {problem.lambda * v0, problem.lambda * v1};
+      case Solver::preconditioned: {
+        // H^{-1} mixes v0 (left-trivialised at g0) with v1 (at g1). Mixed
+        // as they are, the step would keep left and right equivariance but
+        // not inverse equivariance: inversion maps v0 -> -Ad_g0 v0 and
+        // v1 -> -Ad_g1 v1, two different frames. Carrying each across by
+        // half the geodesic, T = Ad_exp(X/2), restores it (T transforms as
+        // Ad_g0 T Ad_g1^{-1} under inversion), and it is also the first-order
+        // term of Gauss-Newton's coupling, K01 = b (I + A/2) + O(A^2).
+        const Scalar determinant = problem.a * problem.c - problem.b * problem.b;
+        const AdMatrix forward = G::Ad(G::exp(state.x / 2));    // from g1's frame to g0's
+        const AdMatrix backward = G::Ad(G::exp(-state.x / 2));  // from g0's frame to g1's
+        return {(problem.c * v0 - problem.b * (forward * v1)) / determinant,
+                (problem.a * v1 - problem.b * (backward * v0)) / determinant};
+      }
+      case Solver::gauss_newton:
+        return gauss_newton_step(problem, state);
+    }
+    return {v0, v1};
+  }
+
+  // (d0, d1) = K^{-1} (v0, v1) with K = [a I, K01; K10, c I] (DESIGN.md,
+  // "Equivariant Gauss-Newton"); the blocks by Horner's rule in A = ad_X.
+  // Fixed-size throughout: no heap allocation.
+  std::pair<Tangent, Tangent> gauss_newton_step(const Problem& problem, const State& state) const {
+    constexpr int d = G::dof;
+    using KMatrix = Eigen::Matrix<Scalar, 2 * d, 2 * d>;
+    using KVector = Eigen::Matrix<Scalar, 2 * d, 1>;
+    const AdMatrix identity = AdMatrix::Identity();
+    AdMatrix k01 = problem.k01[kGaussNewtonOrder] * identity;
+    AdMatrix k10 = problem.k10[kGaussNewtonOrder] * identity;
+    for (int m = kGaussNewtonOrder - 1; m >= 0; --m) {
+      k01 = state.a * k01 + problem.k01[m] * identity;
+      k10 = state.a * k10 + problem.k10[m] * identity;
+    }
+    KMatrix k;
+    k.template topLeftCorner<d, d>() = problem.a * identity;
+    k.template topRightCorner<d, d>() = k01;
+    k.template bottomLeftCorner<d, d>() = k10;
+    k.template bottomRightCorner<d, d>() = problem.c * identity;
+    KVector v;
+    v.template head<d>() = state.force.v0;
+    v.template tail<d>() = state.force.v1;
+    const KVector delta = k.partialPivLu().solve(v);
+    return {delta.template head<d>(), delta.template tail<d>()};
+  }
+
+  // The iteration g0 <- g0 exp(d0), g1 <- g1 exp(d1) (the paper's eq.
+  // "algorithm" for Solver::paper) until the full step's norm is at or below
+  // the tolerance. Every solver but paper carries a safeguard: a step that
+  // would increase ||v|| is halved (up to kMaxHalvings times), so a fast step
+  // cannot overshoot where the paper's step converges (a full step on a
+  // long geodesic can carry an endpoint past pi). The test uses the
+  // Euclidean norm of v in left-trivialised coordinates: left-invariant, and
+  // only approximately right-invariant on groups without a bi-invariant
+  // metric (SE(3)), which matters only for a borderline halving decision.
+  // No heap allocation happens inside the loop (the history is reserved).
   template <class Observations>
   void iterate(const Observations& observations, const Problem& problem, Element& g0, Element& g1,
                Result& result) const {
     using std::isfinite;
-    constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
+    using std::sqrt;
     // A step this much larger than the smallest one seen, and not at the
     // rounding level of the tolerance, means the iteration left the basin
     // where it contracts.
     constexpr Scalar kDivergenceGrowth = Scalar(1e3);
+    constexpr int kMaxHalvings = 30;
 
     result.step_norms.reserve(static_cast<std::size_t>(options_.max_iterations));
     if (options_.record_iterates) {
       result.iterates.reserve(static_cast<std::size_t>(options_.max_iterations));
     }
     result.status = Status::max_iterations;
+    const bool safeguarded = options_.solver != Solver::paper;
     Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
+    State state = evaluate(observations, problem, g0, g1);
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
-      const Tangent x = log_at<G>(g0, g1);
-      if (!(ad_spectral_radius<G>(x) < kTwoPi)) {
+      if (!state.series_converges) {
         result.status = Status::series_diverged;
         return;
       }
-      const AdMatrix a = G::ad(x);
-      const auto [order, truncation] = series_order(a);
-      result.diagnostics.series_order = order;
-      result.diagnostics.series_truncation_bound = truncation;
+      result.diagnostics.series_order = state.order;
+      result.diagnostics.series_truncation_bound = state.truncation;
 
-      const Force force = net_force(observations, problem, g0, x, a, order);
-      const Tangent step0 = problem.lambda * force.v0;
-      const Tangent step1 = problem.lambda * force.v1;
-      const Scalar step_norm = problem.lambda * force.norm();
+      const auto [d0, d1] = step(problem, state);
+      const Scalar step_norm = sqrt(d0.squaredNorm() + d1.squaredNorm());
       if (!isfinite(step_norm) || (step_norm > kDivergenceGrowth * smallest_step &&
                                    step_norm > kDivergenceGrowth * options_.tolerance)) {
         result.status = Status::diverged;
@@ -467,9 +656,24 @@ class GeodesicRegression {
       }
       smallest_step = std::min(smallest_step, step_norm);
 
-      g0 = exp_at<G>(g0, step0);
-      g1 = exp_at<G>(g1, step1);
-      result.step_norms.push_back(step_norm);
+      Scalar fraction = 1;
+      State next =
+          evaluate(observations, problem, exp_at<G>(state.g0, d0), exp_at<G>(state.g1, d1));
+      if (safeguarded) {
+        const Scalar force_norm = state.force.norm();
+        for (int halving = 0;
+             halving < kMaxHalvings && !(next.series_converges && next.force.norm() <= force_norm);
+             ++halving) {
+          fraction /= 2;
+          ++result.diagnostics.backtracks;
+          next = evaluate(observations, problem, exp_at<G>(state.g0, fraction * d0),
+                          exp_at<G>(state.g1, fraction * d1));
+        }
+      }
+      state = next;
+      g0 = state.g0;
+      g1 = state.g1;
+      result.step_norms.push_back(fraction * step_norm);
       result.iterations = iteration + 1;
       if (options_.record_iterates) result.iterates.emplace_back(g0, g1);
       if (step_norm <= options_.tolerance) {
