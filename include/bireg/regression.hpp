@@ -122,8 +122,10 @@ inline const char* to_string(Solver solver) {
 
 // Truncation order of the power series that build Gauss-Newton's K. K only
 // shapes the step, not the fixed point, so it needs modest accuracy: at the
-// largest spectral radius (pi) the omitted terms are below 2^-24 ~ 6e-8.
-inline constexpr int kGaussNewtonOrder = 24;
+// largest spectral radius of SO(3) and SE(3) (pi) the omitted terms are
+// below 2^-16 ~ 2e-5 relative, which changes the contraction factor by as
+// much and nothing else.
+inline constexpr int kGaussNewtonOrder = 16;
 
 template <class G>
 class GeodesicRegression {
@@ -177,27 +179,33 @@ class GeodesicRegression {
     Scalar contraction_factor = 0;
     int series_order = 0;                // order used in the last iteration
     Scalar series_truncation_bound = 0;  // relative size of the omitted terms
-    Scalar force_norm = 0;               // ||(v0, v1)|| at the returned endpoints
+    Scalar force_norm = 0;  // ||(v0, v1)|| at the returned endpoints (0: series_diverged)
     // sqrt(sum w_i |r_i|^2 / sum w_i), residuals about the fitted geodesic,
-    // and the same about the constant model (the data's bi-invariant mean).
+    // and the data's spread about their mean, sqrt(sum w_i |y_i - ybar|^2 /
+    // sum w_i) with y_i = log(f_ref^{-1} f_i) in the chart at the middle
+    // observation (the constant model; see chart_fit).
     Scalar residual_rms = 0;
     Scalar residual_rms_about_mean = 0;
     // 1 - residual_rms^2 / residual_rms_about_mean^2: the share of the
-    // data's spread about its bi-invariant mean that the geodesic explains.
-    // On R^n it is the ordinary R^2. Norms are Euclidean in the tangent
-    // coordinates (which mix units on SE(3)); 1 when the data do not spread.
+    // data's spread that the geodesic explains. On R^n it is the ordinary
+    // R^2. Norms are Euclidean in the tangent coordinates (which mix units
+    // on SE(3)); 1 when the data do not spread.
     Scalar explained_variance = 0;
   };
 
   struct Result {
     Status status = Status::invalid_input;
-    std::string message;             // what was wrong, for invalid_input
-    std::ptrdiff_t bad_index = -1;   // offending observation, if any
-    Geodesic<G> geodesic;            // in the user's covariate units
-    int iterations = 0;              // steps taken
-    std::vector<Scalar> step_norms;  // norm of every step taken
+    std::string message;            // what was wrong, for invalid_input
+    std::ptrdiff_t bad_index = -1;  // offending observation, if any
+    Geodesic<G> geodesic;           // in the user's covariate units
+    // Iterations: evaluations of the step at the current endpoints. Each but
+    // the last of a converged fit is taken; the last, at or below the
+    // tolerance, certifies the returned endpoints. step_norms holds the norm
+    // of every proposed step (before any safeguard halving).
+    int iterations = 0;
+    std::vector<Scalar> step_norms;
     std::vector<Tangent> residuals;  // r_i = log(gamma(t_i)^{-1} f_i), input order
-    std::vector<std::pair<Element, Element>> iterates;  // if Options::record_iterates
+    std::vector<std::pair<Element, Element>> iterates;  // after each step taken, if recorded
     Diagnostics diagnostics;
 
     bool ok() const { return status == Status::converged; }
@@ -220,15 +228,14 @@ class GeodesicRegression {
     result.diagnostics.mu_max = problem.mu_max;
     result.diagnostics.step_size = problem.lambda;
 
-    Element g0, g1;
+    const Chart chart = chart_fit(observations, problem);
+    Element g0 = chart.g0, g1 = chart.g1;
     if (options_.initial_guess) {
       g0 = options_.initial_guess->first;
       g1 = options_.initial_guess->second;
-    } else {
-      std::tie(g0, g1) = initial_guess(observations, problem);
     }
-    iterate(observations, problem, g0, g1, result);
-    finish(observations, problem, g0, g1, result);
+    const State final_state = iterate(observations, problem, g0, g1, result);
+    finish(observations, problem, final_state, chart.spread, result);
     return result;
   }
 
@@ -414,43 +421,61 @@ class GeodesicRegression {
   // independent of N. At z = 0 both blocks reduce to b = sum w t (1 - t), so
   // K = H kron I on commutative groups.
   static void gauss_newton_coefficients(Problem& problem) {
+    // Mixed moments S[p][q] = sum_i w_i t_i^p u_i^q for p, q >= 1,
+    // p + q <= kOrder + 2: then [z^m] sum_i w_i g_{t_i} =
+    // sum_k (-1)^k T[m][k] S[m-k+1][k+1] (T[m][k] = b_k / (m-k+1)!), and the
+    // mirror block swaps p and q.
     constexpr int kOrder = kGaussNewtonOrder;
-    std::array<Scalar, kOrder + 2> t_power{}, u_power{};  // t^j, u^j for j = 0 .. kOrder + 1
+    constexpr int kPowers = kOrder + 2;
+    std::array<std::array<Scalar, kPowers + 1>, kPowers + 1> moments{};
+    std::array<Scalar, kPowers + 1> t_power{}, u_power{};
     for (std::size_t i = 0; i < problem.t.size(); ++i) {
-      const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
-      t_power[0] = u_power[0] = 1;
-      for (int j = 1; j <= kOrder + 1; ++j) {
+      const Scalar t = problem.t[i], u = 1 - t;
+      t_power[0] = problem.w[i];
+      u_power[0] = 1;
+      for (int j = 1; j <= kPowers; ++j) {
         t_power[j] = t_power[j - 1] * t;
         u_power[j] = u_power[j - 1] * u;
       }
-      for (int m = 0; m <= kOrder; ++m) {
-        Scalar start = 0, end = 0;  // [z^m] g_t and [z^m] g_{1-t}(-z), up to (-1)^m
-        for (int k = 0; k <= m; ++k) {
-          const int n = m - k;
-          // kPsiSeriesTable[m][k] = b_k / (m - k + 1)! = b_k / (n + 1)!
-          const Scalar coefficient = static_cast<Scalar>(kPsiSeriesTable[m][k]);
-          const Scalar signed_coefficient = k % 2 == 0 ? coefficient : -coefficient;
-          start += signed_coefficient * t_power[n + 1] * u_power[k + 1];
-          end += signed_coefficient * u_power[n + 1] * t_power[k + 1];
-        }
-        problem.k01[m] += w * start;
-        problem.k10[m] += w * (m % 2 == 0 ? end : -end);
+      for (int p = 1; p < kPowers; ++p) {
+        for (int q = 1; p + q <= kPowers; ++q)
+          moments[p][q] += t_power[p] * u_power[q];
       }
+    }
+    for (int m = 0; m <= kOrder; ++m) {
+      Scalar start = 0, end = 0;
+      for (int k = 0; k <= m; ++k) {
+        const Scalar coefficient = static_cast<Scalar>(kPsiSeriesTable[m][k]);
+        const Scalar signed_coefficient = k % 2 == 0 ? coefficient : -coefficient;
+        start += signed_coefficient * moments[m - k + 1][k + 1];
+        end += signed_coefficient * moments[k + 1][m - k + 1];
+      }
+      problem.k01[m] = start;
+      problem.k10[m] = m % 2 == 0 ? end : -end;
     }
   }
 
-  // Default start: the weighted least-squares line through the data in the
-  // log chart at f_ref, the observation nearest the middle of the covariate
-  // range, y_i = log(f_ref^{-1} f_i) ~ (1 - t_i) x0 + t_i x1, i.e.
-  // (x0, x1) = (H^{-1} kron I) (sum w (1-t) y, sum w t y), and
-  // (g0, g1) = (f_ref exp(x0), f_ref exp(x1)). It is exact on commutative
-  // groups, first-order accurate otherwise, and, like the iteration,
-  // equivariant under left and right translation and inversion (the chart
-  // moves with f_ref), so the whole fit stays equivariant. The middle
-  // observation keeps the chart's distortion smallest for the endpoints.
+  // One pass over the data in the log chart at f_ref, the observation nearest
+  // the middle of the covariate range, y_i = log(f_ref^{-1} f_i). It gives
+  //
+  //  * the default start: the weighted least-squares line y_i ~ (1 - t_i) x0
+  //    + t_i x1, i.e. (x0, x1) = (H^{-1} kron I)(sum w (1-t) y, sum w t y),
+  //    (g0, g1) = (f_ref exp(x0), f_ref exp(x1)). It is exact on commutative
+  //    groups, first-order accurate otherwise, and, like the iteration,
+  //    equivariant under left and right translation and inversion (the chart
+  //    moves with f_ref), so the whole fit stays equivariant. The middle
+  //    observation keeps the chart's distortion smallest for the endpoints;
+  //  * the data's spread about their mean in that chart,
+  //    sum w |y_i - ybar|^2: on commutative groups exactly the total sum of
+  //    squares of ordinary regression; otherwise the spread about the
+  //    bi-invariant mean up to terms of third order in the data's radius.
+  struct Chart {
+    Element g0, g1;
+    Scalar spread = 0;
+  };
+
   template <class Observations>
-  std::pair<Element, Element> initial_guess(const Observations& observations,
-                                            const Problem& problem) const {
+  Chart chart_fit(const Observations& observations, const Problem& problem) const {
     const std::size_t n = observations.size();
     std::size_t reference = 0;
     for (std::size_t i = 1; i < n; ++i) {
@@ -460,15 +485,22 @@ class GeodesicRegression {
     const Element& f_ref = observations[reference];
     const Element f_ref_inverse = G::inverse(f_ref);
     Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
+    Scalar square_sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
       moment0 += problem.w[i] * (1 - problem.t[i]) * y;
       moment1 += problem.w[i] * problem.t[i] * y;
+      square_sum += problem.w[i] * y.squaredNorm();
     }
     const Scalar determinant = problem.a * problem.c - problem.b * problem.b;
     const Tangent x0 = (problem.c * moment0 - problem.b * moment1) / determinant;
     const Tangent x1 = (problem.a * moment1 - problem.b * moment0) / determinant;
-    return {exp_at<G>(f_ref, x0), exp_at<G>(f_ref, x1)};
+    const Tangent total = moment0 + moment1;  // sum w y
+    Chart chart;
+    chart.g0 = exp_at<G>(f_ref, x0);
+    chart.g1 = exp_at<G>(f_ref, x1);
+    chart.spread = std::max(Scalar(0), square_sum - total.squaredNorm() / problem.weight_sum);
+    return chart;
   }
 
   // The net force of eq. "v" at (g0, g1), x = log(g0^{-1} g1), a = ad_x.
@@ -538,9 +570,11 @@ class GeodesicRegression {
     bool series_converges = true;  // spectral radius of ad_x below 2 pi
   };
 
+  // Evaluates x, ad_x, the series order and the force at (g0, g1), writing
+  // the residuals there into `residuals` (sized N).
   template <class Observations>
   State evaluate(const Observations& observations, const Problem& problem, const Element& g0,
-                 const Element& g1) const {
+                 const Element& g1, std::vector<Tangent>& residuals) const {
     constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
     State state;
     state.g0 = g0;
@@ -552,7 +586,7 @@ class GeodesicRegression {
       return state;
     }
     std::tie(state.order, state.truncation) = series_order(state.a);
-    state.force = net_force(observations, problem, g0, state.x, state.a, state.order);
+    state.force = net_force(observations, problem, g0, state.x, state.a, state.order, &residuals);
     return state;
   }
 
@@ -611,24 +645,30 @@ class GeodesicRegression {
   }
 
   // The iteration g0 <- g0 exp(d0), g1 <- g1 exp(d1) (the paper's eq.
-  // "algorithm" for Solver::paper) until the full step's norm is at or below
-  // the tolerance. Every solver but paper carries a safeguard: a step that
-  // would increase ||v|| is halved (up to kMaxHalvings times), so a fast step
-  // cannot overshoot where the paper's step converges (a full step on a
-  // long geodesic can carry an endpoint past pi). The test uses the
-  // Euclidean norm of v in left-trivialised coordinates: left-invariant, and
-  // only approximately right-invariant on groups without a bi-invariant
-  // metric (SE(3)), which matters only for a borderline halving decision.
-  // No heap allocation happens inside the loop (the history is reserved).
+  // "algorithm" for Solver::paper) until the step proposed at the current
+  // endpoints has norm at or below the tolerance; those endpoints are
+  // returned (for the paper solver ||v|| <= tolerance / lambda holds there). Every solver but paper
+  // carries a safeguard: a step that would increase ||v|| is halved (up to kMaxHalvings times), so
+  // a fast step cannot overshoot where the paper's step converges (a full step on a long geodesic
+  // can carry an endpoint past pi). The test uses the Euclidean norm of v in left-trivialised
+  // coordinates: left-invariant, and only approximately right-invariant on groups without a
+  // bi-invariant metric (SE(3)), which matters only for a borderline halving decision. No heap
+  // allocation happens inside the loop (the history is reserved). Returns the state at the returned
+  // endpoints; result.residuals hold the residuals there (unless the series did not converge at
+  // that state).
   template <class Observations>
-  void iterate(const Observations& observations, const Problem& problem, Element& g0, Element& g1,
-               Result& result) const {
+  State iterate(const Observations& observations, const Problem& problem, const Element& start0,
+                const Element& start1, Result& result) const {
     using std::isfinite;
     using std::sqrt;
-    // A step this much larger than the smallest one seen, and not at the
-    // rounding level of the tolerance, means the iteration left the basin
-    // where it contracts.
+    // A step this much larger than the smallest one seen means the
+    // iteration left the basin where it contracts, unless both are at the
+    // rounding level (below sqrt(epsilon), or the tolerance), where steps
+    // fluctuate by orders of magnitude without meaning anything.
     constexpr Scalar kDivergenceGrowth = Scalar(1e3);
+    const Scalar divergence_floor =
+        kDivergenceGrowth *
+        std::max(options_.tolerance, sqrt(std::numeric_limits<Scalar>::epsilon()));
     constexpr int kMaxHalvings = 30;
 
     result.step_norms.reserve(static_cast<std::size_t>(options_.max_iterations));
@@ -636,29 +676,38 @@ class GeodesicRegression {
       result.iterates.reserve(static_cast<std::size_t>(options_.max_iterations));
     }
     result.status = Status::max_iterations;
+    result.residuals.resize(observations.size());
     const bool safeguarded = options_.solver != Solver::paper;
     Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
-    State state = evaluate(observations, problem, g0, g1);
+    State state = evaluate(observations, problem, start0, start1, result.residuals);
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       if (!state.series_converges) {
         result.status = Status::series_diverged;
-        return;
+        return state;
       }
       result.diagnostics.series_order = state.order;
       result.diagnostics.series_truncation_bound = state.truncation;
 
       const auto [d0, d1] = step(problem, state);
       const Scalar step_norm = sqrt(d0.squaredNorm() + d1.squaredNorm());
-      if (!isfinite(step_norm) || (step_norm > kDivergenceGrowth * smallest_step &&
-                                   step_norm > kDivergenceGrowth * options_.tolerance)) {
+      if (!isfinite(step_norm) ||
+          (step_norm > kDivergenceGrowth * smallest_step && step_norm > divergence_floor)) {
         result.status = Status::diverged;
-        return;
+        return state;
       }
       smallest_step = std::min(smallest_step, step_norm);
+      result.step_norms.push_back(step_norm);
+      result.iterations = iteration + 1;
+      // The step proposed at the current endpoints certifies them: it is
+      // what remains to be moved, so it is not taken when below tolerance.
+      if (step_norm <= options_.tolerance) {
+        result.status = Status::converged;
+        return state;
+      }
 
       Scalar fraction = 1;
-      State next =
-          evaluate(observations, problem, exp_at<G>(state.g0, d0), exp_at<G>(state.g1, d1));
+      State next = evaluate(observations, problem, exp_at<G>(state.g0, d0), exp_at<G>(state.g1, d1),
+                            result.residuals);
       if (safeguarded) {
         const Scalar force_norm = state.force.norm();
         for (int halving = 0;
@@ -667,80 +716,43 @@ class GeodesicRegression {
           fraction /= 2;
           ++result.diagnostics.backtracks;
           next = evaluate(observations, problem, exp_at<G>(state.g0, fraction * d0),
-                          exp_at<G>(state.g1, fraction * d1));
+                          exp_at<G>(state.g1, fraction * d1), result.residuals);
         }
       }
       state = next;
-      g0 = state.g0;
-      g1 = state.g1;
-      result.step_norms.push_back(fraction * step_norm);
-      result.iterations = iteration + 1;
-      if (options_.record_iterates) result.iterates.emplace_back(g0, g1);
-      if (step_norm <= options_.tolerance) {
-        result.status = Status::converged;
-        return;
-      }
+      if (options_.record_iterates) result.iterates.emplace_back(state.g0, state.g1);
     }
+    return state;
   }
 
-  // Residuals, the force at the returned endpoints, and the diagnostics.
+  // The geodesic and the diagnostics at the returned endpoints.
   template <class Observations>
-  void finish(const Observations& observations, const Problem& problem, const Element& g0,
-              const Element& g1, Result& result) const {
+  void finish(const Observations& observations, const Problem& problem, const State& state,
+              Scalar spread, Result& result) const {
     using std::sqrt;
     const std::size_t n = observations.size();
-    result.geodesic = Geodesic<G>(g0, g1, problem.t_min, problem.t_max);
-    result.residuals.resize(n);
-    const Tangent x = log_at<G>(g0, g1);
-    const AdMatrix a = G::ad(x);
-    const int order = series_order(a).first;
-    const Force force = net_force(observations, problem, g0, x, a, order, &result.residuals);
-
+    result.geodesic = Geodesic<G>(state.g0, state.g1, problem.t_min, problem.t_max);
     Diagnostics& d = result.diagnostics;
-    d.force_norm = force.norm();
+    if (state.series_converges) {
+      d.force_norm = state.force.norm();
+    } else {  // no force to report (0); the residuals need no series
+      const Element g0_inverse = G::inverse(state.g0);
+      for (std::size_t i = 0; i < n; ++i) {
+        result.residuals[i] = G::log(
+            G::compose(G::exp(-problem.t[i] * state.x), G::compose(g0_inverse, observations[i])));
+      }
+    }
     const std::size_t steps = result.step_norms.size();
     if (steps >= 2 && result.step_norms[steps - 2] > 0) {
       d.contraction_factor = result.step_norms[steps - 1] / result.step_norms[steps - 2];
     }
     Scalar residual_sum = 0;
-    for (std::size_t i = 0; i < n; ++i)
-      residual_sum += problem.w[i] * result.residuals[i].squaredNorm();
-    d.residual_rms = sqrt(residual_sum / problem.weight_sum);
-    const Scalar spread_sum = spread_about_mean(observations, problem, result.geodesic);
-    d.residual_rms_about_mean = sqrt(spread_sum / problem.weight_sum);
-    d.explained_variance = spread_sum > 0 ? 1 - residual_sum / spread_sum : Scalar(1);
-  }
-
-  // sum w_i |log(m^{-1} f_i)|^2 about the data's bi-invariant (exponential)
-  // mean m, the fixed point of m <- m exp(sum w log(m^{-1} f) / sum w) (the
-  // constant-geodesic case of the same estimator), started at the fitted
-  // geodesic's point at the weighted mean covariate.
-  template <class Observations>
-  Scalar spread_about_mean(const Observations& observations, const Problem& problem,
-                           const Geodesic<G>& geodesic) const {
-    const std::size_t n = observations.size();
-    Scalar mean_t = 0;
-    for (std::size_t i = 0; i < n; ++i)
-      mean_t += problem.w[i] * problem.t[i];
-    mean_t /= problem.weight_sum;
-    Element mean = exp_at<G>(geodesic.start(), mean_t * geodesic.displacement());
-    constexpr int kMeanIterations = 100;
-    for (int iteration = 0; iteration < kMeanIterations; ++iteration) {
-      const Element mean_inverse = G::inverse(mean);
-      Tangent step = Tangent::Zero();
-      for (std::size_t i = 0; i < n; ++i) {
-        step += problem.w[i] * G::log(G::compose(mean_inverse, observations[i]));
-      }
-      step /= problem.weight_sum;
-      mean = exp_at<G>(mean, step);
-      if (!(step.norm() > options_.tolerance)) break;
-    }
-    const Element mean_inverse = G::inverse(mean);
-    Scalar sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      sum += problem.w[i] * G::log(G::compose(mean_inverse, observations[i])).squaredNorm();
+      residual_sum += problem.w[i] * result.residuals[i].squaredNorm();
     }
-    return sum;
+    d.residual_rms = sqrt(residual_sum / problem.weight_sum);
+    d.residual_rms_about_mean = sqrt(spread / problem.weight_sum);
+    d.explained_variance = spread > 0 ? 1 - residual_sum / spread : Scalar(1);
   }
 
   Options options_;
