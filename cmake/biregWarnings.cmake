@@ -1,6 +1,17 @@
-# Warning flags for bireg's own targets (tests, examples, benchmarks). The
-# library target itself carries no flags: consumers choose their own.
+# Warning (and optional sanitizer) flags for bireg's own targets (tests,
+# examples, benchmarks). The library target itself carries no flags:
+# consumers choose their own.
+#
+# BIREG_SANITIZE: a -fsanitize= list such as "address,undefined" for the
+# tests, examples and tools (the CI sanitizer stage); empty by default.
+set(BIREG_SANITIZE "" CACHE STRING "Sanitizers for bireg's tests and tools, e.g. address,undefined")
+
 function(bireg_enable_warnings target)
+  if(BIREG_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=${BIREG_SANITIZE} -fno-sanitize-recover=all
+      -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=${BIREG_SANITIZE})
+  endif()
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror)
   elseif(MSVC)

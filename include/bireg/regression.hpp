@@ -73,6 +73,9 @@ enum class Status {
   diverged,         // the steps grew without bound (or became non-finite)
   series_diverged,  // spectral radius of ad_X reached 2 pi: the inverse
                     // differentials' series no longer converges
+  stalled,          // the safeguard found no step that decreases ||v||: the data
+                    // lie outside the region where the estimator is defined
+                    // (e.g. a rotation of more than pi along the geodesic)
   invalid_input,    // rejected before any work; see Result::message
 };
 
@@ -86,6 +89,8 @@ inline const char* to_string(Status status) {
       return "diverged";
     case Status::series_diverged:
       return "series_diverged";
+    case Status::stalled:
+      return "stalled";
     case Status::invalid_input:
       return "invalid_input";
   }
@@ -169,6 +174,10 @@ class GeodesicRegression {
   struct Diagnostics {
     Scalar mu_min = 0;  // eigenvalues of H (unit covariate interval)
     Scalar mu_max = 0;
+    // mu_max / mu_min: how well the covariates pin down the slope. The
+    // paper solver needs ~condition_number iterations; the slope's error
+    // grows like sqrt(condition_number) times the noise.
+    Scalar condition_number = 0;
     Scalar step_size = 0;  // lambda used (1 for preconditioned and gauss_newton)
     // Step halvings of the safeguard (every solver but paper): a step that
     // would increase ||v|| is halved until it does not.
@@ -226,6 +235,7 @@ class GeodesicRegression {
 
     result.diagnostics.mu_min = problem.mu_min;
     result.diagnostics.mu_max = problem.mu_max;
+    result.diagnostics.condition_number = problem.mu_max / problem.mu_min;
     result.diagnostics.step_size = problem.lambda;
 
     const Chart chart = chart_fit(observations, problem);
@@ -669,7 +679,7 @@ class GeodesicRegression {
     const Scalar divergence_floor =
         kDivergenceGrowth *
         std::max(options_.tolerance, sqrt(std::numeric_limits<Scalar>::epsilon()));
-    constexpr int kMaxHalvings = 30;
+    constexpr int kMaxHalvings = 20;
 
     result.step_norms.reserve(static_cast<std::size_t>(options_.max_iterations));
     if (options_.record_iterates) {
@@ -710,13 +720,22 @@ class GeodesicRegression {
                             result.residuals);
       if (safeguarded) {
         const Scalar force_norm = state.force.norm();
-        for (int halving = 0;
-             halving < kMaxHalvings && !(next.series_converges && next.force.norm() <= force_norm);
-             ++halving) {
+        const auto acceptable = [&](const State& trial) {
+          return trial.series_converges && trial.force.norm() <= force_norm;
+        };
+        for (int halving = 0; halving < kMaxHalvings && !acceptable(next); ++halving) {
           fraction /= 2;
           ++result.diagnostics.backtracks;
           next = evaluate(observations, problem, exp_at<G>(state.g0, fraction * d0),
                           exp_at<G>(state.g1, fraction * d1), result.residuals);
+        }
+        // Every halving failed: no step along this direction decreases the
+        // force. Above the rounding level that means the data are outside
+        // the estimator's domain; stop rather than wander.
+        if (!acceptable(next) && step_norm > divergence_floor / kDivergenceGrowth) {
+          result.status = Status::stalled;
+          evaluate(observations, problem, state.g0, state.g1, result.residuals);
+          return state;
         }
       }
       state = next;
