@@ -2,8 +2,9 @@
 //
 //   B1  BM_Cost/<group>/<order>     one paper-solver fit at a fixed iteration
 //                                   count, per observation and iteration, for
-//                                   series order M (0 = adaptive); compare with
-//                                   BM_ExpLogTwoCompositions in bench_groups
+//                                   series order M (0 = adaptive, -1 = exact);
+//                                   compare with BM_ExpLogTwoCompositions in
+//                                   bench_groups
 //   B3  BM_Solver/<solver>/<length> SE(3), N = 100, noise 0.1, geodesic length
 //                                   0.3, 1, 2.5 rad (x10 in the argument), to
 //                                   tolerance 1e-10: time and iterations
@@ -12,6 +13,7 @@
 //
 // Counters: `iterations` per fit; `time_per_obs_iter` = fit time / (N x
 // iterations), in seconds (printed with an SI prefix: 308n = 308 ns).
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -80,7 +82,12 @@ void BM_Cost(benchmark::State& state) {
   static const Problem<G> problem = make_problem<G>(1000, 1.0, 0.1, 3);
   typename bireg::GeodesicRegression<G>::Options options;
   options.solver = bireg::Solver::paper;
-  options.series_order = static_cast<int>(state.range(0));
+  const int order = static_cast<int>(state.range(0));
+  options.method = order < 0    ? bireg::Method::exact
+                   : order == 0 ? bireg::Method::series_adaptive
+                                : bireg::Method::series;
+  options.series_order = std::max(order, 0);
+  state.SetLabel(bireg::to_string(options.method));
   options.tolerance = 0;
   options.max_iterations = 20;
   run_fits(state, problem, options);

@@ -1,6 +1,6 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
-//   bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum] [--method series|series_adaptive]
+//   bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum] [--method exact|series|series_adaptive]
 //             [--order M] [--solver paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--output-trajectory FILE] FILE|-
@@ -34,7 +34,7 @@ constexpr int kExitNotConverged = 3;
 
 constexpr const char* kUsage =
     "usage: bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum]\n"
-    "                 [--method series|series_adaptive] [--order M]\n"
+    "                 [--method exact|series|series_adaptive] [--order M]\n"
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
     "                 [--output-trajectory FILE] FILE|-\n";
@@ -42,7 +42,7 @@ constexpr const char* kUsage =
 struct Command {
   std::string group;
   bireg::tools::Format format = bireg::tools::Format::matrix;
-  std::string method = "series_adaptive";
+  bireg::Method method = bireg::Method::exact;
   int order = 0;
   bireg::Solver solver = bireg::Solver::gauss_newton;
   double step = 0;
@@ -97,10 +97,15 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
         return "unknown format '" + *v + "' (matrix or tum)";
       }
     } else if (arg == "--method") {
-      if (*v != "series" && *v != "series_adaptive") {
-        return "unknown method '" + *v + "' (series or series_adaptive)";
+      bool known = false;
+      for (bireg::Method method :
+           {bireg::Method::exact, bireg::Method::series, bireg::Method::series_adaptive}) {
+        if (*v == bireg::to_string(method)) {
+          command.method = method;
+          known = true;
+        }
       }
-      command.method = *v;
+      if (!known) return "unknown method '" + *v + "' (exact, series or series_adaptive)";
     } else if (arg == "--order" || arg == "--series-order") {
       if (!parse_count(*v, command.order) || command.order < 1 ||
           command.order > bireg::kMaxSeriesOrder) {
@@ -139,8 +144,11 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   }
   if (command.group.empty()) return "--group is required";
   if (command.input.empty()) return "no input file (use - for standard input)";
-  if (command.method == "series" && !order_given) return "--method series needs --order M";
-  if (command.method == "series_adaptive" && order_given) command.method = "series";
+  if (command.method == bireg::Method::series && !order_given)
+    return "--method series needs --order M";
+  if (command.method != bireg::Method::series && order_given) {
+    return "--order applies to --method series only";
+  }
   return std::nullopt;
 }
 
@@ -166,7 +174,8 @@ int run(const Command& command) {
   }
 
   typename Regression::Options options;
-  options.series_order = command.method == "series" ? command.order : 0;
+  options.method = command.method;
+  options.series_order = command.order;
   options.solver = command.solver;
   options.step_size = command.step;
   if (command.tolerance) options.tolerance = *command.tolerance;
@@ -188,7 +197,8 @@ int run(const Command& command) {
       "%s,\n"
       " \"status\": \"%s\", \"iterations\": %d, \"final_step_norm\": %s,\n"
       " \"diagnostics\": {\"mu_min\": %s, \"mu_max\": %s, \"step_size\": %s, "
-      "\"contraction_factor\": %s, \"series_order\": %d, \"solver\": \"%s\", \"backtracks\": %d, "
+      "\"contraction_factor\": %s, \"method\": \"%s\", \"series_order\": %d, \"solver\": \"%s\", "
+      "\"backtracks\": %d, "
       "\"force_norm\": %s, "
       "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
       G::name, trajectory.observations.size(),
@@ -197,10 +207,10 @@ int run(const Command& command) {
       json_number(result.geodesic.t_min()).c_str(), json_number(result.geodesic.t_max()).c_str(),
       bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
       json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
-      json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(), d.series_order,
-      bireg::to_string(command.solver), d.backtracks, json_number(d.force_norm).c_str(),
-      json_number(d.residual_rms).c_str(), json_number(d.residual_rms_about_mean).c_str(),
-      json_number(d.explained_variance).c_str());
+      json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(),
+      bireg::to_string(command.method), d.series_order, bireg::to_string(command.solver),
+      d.backtracks, json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
+      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
 
   if (!command.output_trajectory.empty()) {
     std::ofstream out(command.output_trajectory);

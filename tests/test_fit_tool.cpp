@@ -205,7 +205,9 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
       {"--group SO3 --solver paper --step 100", "so3_small.csv", "no longer contracts"},
       {"--group SO3 --step 0.01", "so3_small.csv", "step_size applies to the paper solver only"},
       {"--group SO3 --method series", "so3_small.csv", "--method series needs --order M"},
-      {"--group SO3 --order 0", "so3_small.csv", "--order needs an integer"},
+      {"--group SO3 --method series --order 0", "so3_small.csv", "--order needs an integer"},
+      {"--group SO3 --order 8", "so3_small.csv", "--order applies to --method series only"},
+      {"--group SO3 --method taylor", "so3_small.csv", "unknown method 'taylor'"},
       {"--group SO3 --solver newton", "so3_small.csv", "unknown solver 'newton'"},
   };
   for (const Case& c : cases) {

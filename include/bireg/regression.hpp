@@ -61,6 +61,7 @@
 #include <Eigen/LU>
 
 #include "bireg/core/concept.hpp"
+#include "bireg/core/exact_inverse_differential.hpp"
 #include "bireg/core/inverse_differential.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/tolerance.hpp"
@@ -93,6 +94,26 @@ inline const char* to_string(Status status) {
       return "stalled";
     case Status::invalid_input:
       return "invalid_input";
+  }
+  return "unknown";
+}
+
+// How the inverse differentials psi_s(ad_X) are evaluated.
+enum class Method {
+  series,           // the paper's series truncated at Options::series_order
+  series_adaptive,  // the series, truncated where the omitted terms fall below epsilon
+  exact,            // closed form (SO2, SO3, SE2, SE3) where it is accurate, the adaptive
+                    // series elsewhere and for groups without one
+};
+
+inline const char* to_string(Method method) {
+  switch (method) {
+    case Method::series:
+      return "series";
+    case Method::series_adaptive:
+      return "series_adaptive";
+    case Method::exact:
+      return "exact";
   }
   return "unknown";
 }
@@ -143,10 +164,13 @@ class GeodesicRegression {
   using AdMatrix = typename G::AdMatrix;
 
   struct Options {
-    // Truncation order M of the inverse-differential series: 0 chooses it
-    // adaptively at every iteration (the smallest M whose omitted terms are
-    // below epsilon relative, see adaptive_series_order), capped at
-    // max_series_order; M >= 1 fixes it.
+    // Evaluation of the inverse differentials (see Method). The closed form
+    // is the most accurate and, on the groups that have one, not slower.
+    Method method = Method::exact;
+    // Truncation order M for Method::series (M >= 1; 0 = adaptive, as
+    // Method::series_adaptive, which picks the smallest M whose omitted
+    // terms are below epsilon relative at every iteration, capped at
+    // max_series_order).
     int series_order = 0;
     int max_series_order = kMaxSeriesOrder;
     // The step rule (see Solver). Gauss-Newton converges in a handful of
@@ -310,6 +334,9 @@ class GeodesicRegression {
     if (options_.max_series_order < 1 || options_.max_series_order > kMaxSeriesOrder) {
       return reject(result,
                     "max_series_order must be in [1, " + std::to_string(kMaxSeriesOrder) + "]");
+    }
+    if (options_.method == Method::series && options_.series_order < 1) {
+      return reject(result, "method series needs series_order >= 1");
     }
     if (options_.series_order < 0 || options_.series_order > kMaxSeriesOrder) {
       return reject(result, "series_order must be 0 (adaptive) or in [1, " +
@@ -562,9 +589,32 @@ class GeodesicRegression {
     return force;
   }
 
+  // The net force with psi in closed form (core/exact_inverse_differential):
+  // v0 = sum w psi_{1-t}(-A) r, v1 = sum w psi_t(A) r, and psi_s(-A) is
+  // psi_s of ad_{-X}. Per observation: the residual plus two closed forms.
+  template <class Observations>
+  Force net_force_exact(const Observations& observations, const Problem& problem, const Element& g0,
+                        const Tangent& x, std::vector<Tangent>& residuals) const {
+    const auto forward = ExactPsi<G>::prepare(x);
+    const auto backward = ExactPsi<G>::prepare(-x);
+    const Element g0_inverse = G::inverse(g0);
+    Force force{Tangent::Zero(), Tangent::Zero()};
+    const std::size_t n = observations.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Scalar t = problem.t[i], w = problem.w[i];
+      const Tangent r = G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, observations[i])));
+      residuals[i] = r;
+      force.v0 += w * ExactPsi<G>::apply(backward, 1 - t, r);
+      force.v1 += w * ExactPsi<G>::apply(forward, t, r);
+    }
+    return force;
+  }
+
   // The series order for the current X (fixed or adaptive).
   std::pair<int, Scalar> series_order(const AdMatrix& a) const {
-    if (options_.series_order > 0) return {options_.series_order, Scalar(0)};
+    if (options_.method == Method::series && options_.series_order > 0) {
+      return {options_.series_order, Scalar(0)};
+    }
     return adaptive_series_order(a, std::numeric_limits<Scalar>::epsilon(),
                                  options_.max_series_order);
   }
@@ -594,6 +644,15 @@ class GeodesicRegression {
     if (!(ad_spectral_radius<G>(state.x) < kTwoPi)) {
       state.series_converges = false;
       return state;
+    }
+    if constexpr (ExactPsi<G>::available) {
+      if (options_.method == Method::exact &&
+          ExactPsi<G>::angle(state.x) >= static_cast<Scalar>(kExactMinAngle)) {
+        state.order = 0;  // no truncation
+        state.truncation = 0;
+        state.force = net_force_exact(observations, problem, g0, state.x, residuals);
+        return state;
+      }
     }
     std::tie(state.order, state.truncation) = series_order(state.a);
     state.force = net_force(observations, problem, g0, state.x, state.a, state.order, &residuals);
