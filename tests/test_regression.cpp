@@ -50,6 +50,22 @@ Data<G> geodesic_data(const typename G::Element& g0, const typename G::Tangent& 
   return data;
 }
 
+// The paper's iteration with step `step_size` from (start0, start1), every
+// iterate recorded, for exactly `iterations` steps (tolerance 0).
+template <class G>
+typename bireg::GeodesicRegression<G>::Result recorded_paper_run(
+    const std::vector<typename G::Element>& f, const std::vector<double>& t, double step_size,
+    const typename G::Element& start0, const typename G::Element& start1, int iterations) {
+  typename bireg::GeodesicRegression<G>::Options options;
+  options.solver = bireg::Solver::paper;
+  options.step_size = step_size;
+  options.initial_guess = std::make_pair(start0, start1);
+  options.record_iterates = true;
+  options.max_iterations = iterations;
+  options.tolerance = 0;
+  return bireg::GeodesicRegression<G>(options).fit(f, t);
+}
+
 // Unit eigenvector of H = [a b; b c] (unit covariate interval, unit
 // weights) for its smaller eigenvalue: (b, mu_min - a) solves the first row
 // of (H - mu_min I) e = 0.
@@ -155,20 +171,14 @@ void check_commutative_rate(const std::vector<typename G::Element>& f, const std
   const typename G::Element g0 = G::compose(exact.geodesic.start(), G::exp(e_min[0] * u));
   const typename G::Element g1 = G::compose(exact.geodesic.end(), G::exp(e_min[1] * u));
 
-  typename bireg::GeodesicRegression<G>::Options options;
-  options.solver = bireg::Solver::paper;
-  options.step_size = lambda_fraction / mu_max;
-  options.initial_guess = std::make_pair(g0, g1);
-  options.record_iterates = true;
-  options.max_iterations = 40;
-  options.tolerance = 0;
-  const auto run = bireg::GeodesicRegression<G>(options).fit(f, t);
+  const double step_size = lambda_fraction / mu_max;
+  const auto run = recorded_paper_run<G>(f, t, step_size, g0, g1, 40);
   const auto error = [&](const typename G::Element& x0, const typename G::Element& x1) {
     return std::sqrt(bireg::log_at<G>(exact.geodesic.start(), x0).squaredNorm() +
                      bireg::log_at<G>(exact.geodesic.end(), x1).squaredNorm());
   };
   const double error0 = error(g0, g1);
-  const double factor = 1 - options.step_size * mu_min;
+  const double factor = 1 - step_size * mu_min;
   int checked = 0;
   for (std::size_t n = 1; n <= run.iterates.size(); ++n) {
     const double predicted = std::pow(factor, static_cast<double>(n)) * error0;
@@ -416,14 +426,8 @@ TEST_CASE("the iteration contracts at the rate of the theorem", "[regression][ra
 
     std::vector<int> iterations_to_tolerance;
     for (double fraction : lambda_fractions) {
-      bireg::GeodesicRegression<G>::Options options;
-      options.solver = bireg::Solver::paper;
-      options.step_size = fraction / mu_max;
-      options.initial_guess = std::make_pair(start0, start1);
-      options.record_iterates = true;
-      options.max_iterations = 400;
-      options.tolerance = 0;
-      const auto run = bireg::GeodesicRegression<G>(options).fit(f, t);
+      const double step_size = fraction / mu_max;
+      const auto run = recorded_paper_run<G>(f, t, step_size, start0, start1, 400);
       const double e0 = error(start0, start1);
       double eta = std::numeric_limits<double>::infinity();
       int reached = -1;
@@ -431,8 +435,7 @@ TEST_CASE("the iteration contracts at the rate of the theorem", "[regression][ra
         const double en = error(run.iterates[n - 1].first, run.iterates[n - 1].second);
         if (reached < 0 && en <= 1e-8 * e0) reached = static_cast<int>(n);
         if (en <= 1e-12) break;
-        eta = std::min(eta,
-                       (1 - std::pow(en / e0, 1.0 / static_cast<double>(n))) / options.step_size);
+        eta = std::min(eta, (1 - std::pow(en / e0, 1.0 / static_cast<double>(n))) / step_size);
       }
       REQUIRE(reached > 0);
       iterations_to_tolerance.push_back(reached);

@@ -591,10 +591,13 @@ class GeodesicRegression {
 
   // The net force with psi in closed form (core/exact_inverse_differential):
   // v0 = sum w psi_{1-t}(-A) r, v1 = sum w psi_t(A) r, and psi_s(-A) is
-  // psi_s of ad_{-X}. Per observation: the residual plus two closed forms.
+  // psi_s of ad_{-X}. Both use the angles t theta/2 and (1 - t) theta/2 with
+  // their roles swapped: per observation, the residual, two sin/cos pairs
+  // and two closed forms.
   template <class Observations>
   Force net_force_exact(const Observations& observations, const Problem& problem, const Element& g0,
                         const Tangent& x, std::vector<Tangent>& residuals) const {
+    using SinCos = exact_detail::SinCos<Scalar>;
     const auto forward = ExactPsi<G>::prepare(x);
     const auto backward = ExactPsi<G>::prepare(-x);
     const Element g0_inverse = G::inverse(g0);
@@ -604,8 +607,10 @@ class GeodesicRegression {
       const Scalar t = problem.t[i], w = problem.w[i];
       const Tangent r = G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, observations[i])));
       residuals[i] = r;
-      force.v0 += w * ExactPsi<G>::apply(backward, 1 - t, r);
-      force.v1 += w * ExactPsi<G>::apply(forward, t, r);
+      const SinCos t_half = SinCos::of(t * forward.theta / 2);
+      const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
+      force.v0 += w * ExactPsi<G>::apply(backward, 1 - t, u_half, t_half, r);
+      force.v1 += w * ExactPsi<G>::apply(forward, t, t_half, u_half, r);
     }
     return force;
   }

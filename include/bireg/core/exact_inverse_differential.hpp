@@ -54,6 +54,27 @@ inline constexpr double kExactMinAngle = 0.25;
 
 namespace exact_detail {
 
+// sin and cos of one angle.
+template <class Scalar>
+struct SinCos {
+  Scalar sin, cos;
+  static SinCos of(Scalar angle) {
+    using std::cos;
+    using std::sin;
+    return {sin(angle), cos(angle)};
+  }
+};
+
+// What psi_s at angle theta needs: the half angle theta/2 (per X), and
+// s theta/2 and (1 - s) theta/2 (per observation). The regression evaluates
+// psi_t for v1 and psi_{1-t} for v0, which use the same two angles with
+// their roles swapped, so each observation costs two sin/cos pairs.
+template <class Scalar>
+struct Angles {
+  Scalar theta;
+  SinCos<Scalar> half, s_half, u_half;  // theta/2, s theta/2, (1 - s) theta/2
+};
+
 // The scalar coefficients of psi_s at the angle theta (theta > 0, s in (0, 1]).
 template <class Scalar>
 struct PsiCoefficients {
@@ -61,16 +82,14 @@ struct PsiCoefficients {
 };
 
 template <class Scalar>
-PsiCoefficients<Scalar> psi_coefficients(Scalar theta, Scalar s) {
-  using std::cos;
-  using std::sin;
-  const Scalar half = theta / 2, s_half = s * theta / 2;
-  const Scalar modulus = s * s * sin(half) / sin(s_half);
-  const Scalar phase = -(1 - s) * half;
-  const Scalar alpha = modulus * cos(phase), beta = modulus * sin(phase);
+PsiCoefficients<Scalar> psi_coefficients(const Angles<Scalar>& a, Scalar s) {
+  const Scalar theta = a.theta;
+  const Scalar modulus = s * s * a.half.sin / a.s_half.sin;
+  // F(i theta) = modulus e^{-i (1 - s) theta / 2}
+  const Scalar alpha = modulus * a.u_half.cos, beta = -modulus * a.u_half.sin;
   // F'/F = p + i q
   const Scalar p = (s - 1) / 2;
-  const Scalar q = -(cos(half) / sin(half) - s * cos(s_half) / sin(s_half)) / 2;
+  const Scalar q = -(a.half.cos / a.half.sin - s * a.s_half.cos / a.s_half.sin) / 2;
   const Scalar alpha_d = alpha * p - beta * q, beta_d = alpha * q + beta * p;
   const Scalar theta2 = theta * theta;
   PsiCoefficients<Scalar> c;
@@ -84,9 +103,10 @@ PsiCoefficients<Scalar> psi_coefficients(Scalar theta, Scalar s) {
 }  // namespace exact_detail
 
 // ExactPsi<G>::available tells whether G has a closed form. prepare(x)
-// caches what depends on X only; apply(prepared, s, r) returns psi_s(ad_X) r
-// and requires the rotation angle of X to be at least kExactMinAngle (SO(2)
-// needs none).
+// caches what depends on X only; apply(prepared, s, s_half, u_half, r)
+// returns psi_s(ad_X) r given sin/cos of s theta/2 and (1 - s) theta/2
+// (angles(prepared, s) computes them), and requires the rotation angle of
+// X to be at least kExactMinAngle (SO(2) needs none).
 template <class G, class = void>
 struct ExactPsi {
   static constexpr bool available = false;
@@ -96,25 +116,37 @@ template <class Scalar>
 struct ExactPsi<SO2<Scalar>> {
   static constexpr bool available = true;
   using Tangent = typename SO2<Scalar>::Tangent;
-  struct Prepared {};
+  using SinCos = exact_detail::SinCos<Scalar>;
+  struct Prepared {
+    Scalar theta = 0;
+    SinCos half{0, 1};
+  };
   static Scalar angle(const Tangent&) { return Scalar(kExactMinAngle); }  // ad = 0: always exact
   static Prepared prepare(const Tangent&) { return {}; }
-  static Tangent apply(const Prepared&, Scalar s, const Tangent& r) { return s * r; }
+  static Tangent apply(const Prepared&, Scalar s, const SinCos&, const SinCos&, const Tangent& r) {
+    return s * r;
+  }
 };
 
 template <class Scalar>
 struct ExactPsi<SO3<Scalar>> {
   static constexpr bool available = true;
   using Tangent = typename SO3<Scalar>::Tangent;
+  using SinCos = exact_detail::SinCos<Scalar>;
   struct Prepared {
     Tangent omega;
     Scalar theta;
+    SinCos half;
   };
   static Scalar angle(const Tangent& x) { return x.norm(); }
-  static Prepared prepare(const Tangent& x) { return {x, x.norm()}; }
-  static Tangent apply(const Prepared& p, Scalar s, const Tangent& r) {
+  static Prepared prepare(const Tangent& x) {
+    const Scalar theta = x.norm();
+    return {x, theta, SinCos::of(theta / 2)};
+  }
+  static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                       const Tangent& r) {
     if (s == 0) return Tangent::Zero();
-    const auto c = exact_detail::psi_coefficients(p.theta, s);
+    const auto c = exact_detail::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
     const Tangent w_r = p.omega.cross(r);
     return s * r + c.f1 * w_r + c.f2 * p.omega.cross(w_r);
   }
@@ -124,25 +156,30 @@ template <class Scalar>
 struct ExactPsi<SE2<Scalar>> {
   static constexpr bool available = true;
   using Tangent = typename SE2<Scalar>::Tangent;
+  using SinCos = exact_detail::SinCos<Scalar>;
   struct Prepared {
     Tangent x;
-    Scalar theta;
+    Scalar theta;  // |theta|; the sign is carried by x[2]
+    SinCos half;
   };
   static Scalar angle(const Tangent& x) {
     using std::abs;
     return abs(x[2]);
   }
-  static Prepared prepare(const Tangent& x) { return {x, x[2]}; }
-  static Tangent apply(const Prepared& p, Scalar s, const Tangent& r) {
+  static Prepared prepare(const Tangent& x) {
     using std::abs;
+    return {x, abs(x[2]), SinCos::of(abs(x[2]) / 2)};
+  }
+  static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                       const Tangent& r) {
     if (s == 0) return Tangent::Zero();
-    // psi is even-odd symmetric: F(-i theta) = conj F(i theta), so the
-    // coefficients at |theta| with the sign carried by J theta.
-    const Scalar theta = p.theta;
-    const auto c = exact_detail::psi_coefficients(abs(theta), s);
+    // F(-i theta) = conj F(i theta): the coefficients at |theta|, the sign
+    // carried by the signed angle.
+    const auto c = exact_detail::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
+    const Scalar theta = p.x[2];
     const Scalar re = s - theta * theta * c.f2;  // Re F(i theta)
     const Scalar im = theta * c.f1;              // Im F(i theta), odd in theta
-    // c = -J rho (the ad column of the angle), then (f1 I + theta f2 J) c.
+    // The angle's ad column is c = -J rho; the block maps it by f1 I + theta f2 J.
     const Scalar cx = p.x[1], cy = -p.x[0];
     const Scalar lx = c.f1 * cx - theta * c.f2 * cy, ly = c.f1 * cy + theta * c.f2 * cx;
     Tangent out;
@@ -158,18 +195,22 @@ struct ExactPsi<SE3<Scalar>> {
   static constexpr bool available = true;
   using Tangent = typename SE3<Scalar>::Tangent;
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using SinCos = exact_detail::SinCos<Scalar>;
   struct Prepared {
     Vector3 rho, omega;
     Scalar theta, omega_dot_rho;
+    SinCos half;
   };
   static Scalar angle(const Tangent& x) { return x.template tail<3>().norm(); }
   static Prepared prepare(const Tangent& x) {
     const Vector3 rho = x.template head<3>(), omega = x.template tail<3>();
-    return {rho, omega, omega.norm(), omega.dot(rho)};
+    const Scalar theta = omega.norm();
+    return {rho, omega, theta, omega.dot(rho), SinCos::of(theta / 2)};
   }
-  static Tangent apply(const Prepared& p, Scalar s, const Tangent& r) {
+  static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                       const Tangent& r) {
     if (s == 0) return Tangent::Zero();
-    const auto c = exact_detail::psi_coefficients(p.theta, s);
+    const auto c = exact_detail::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
     const Vector3 r_rho = r.template head<3>(), r_omega = r.template tail<3>();
     const auto rotation_block = [&](const Vector3& v) {
       const Vector3 w_v = p.omega.cross(v);
@@ -195,7 +236,10 @@ typename G::Tangent apply_psi_exact(const typename G::Tangent& x, typename G::Sc
   using Scalar = typename G::Scalar;
   if constexpr (ExactPsi<G>::available) {
     if (ExactPsi<G>::angle(x) >= static_cast<Scalar>(kExactMinAngle)) {
-      return ExactPsi<G>::apply(ExactPsi<G>::prepare(x), s, r);
+      using SinCos = exact_detail::SinCos<Scalar>;
+      const auto prepared = ExactPsi<G>::prepare(x);
+      return ExactPsi<G>::apply(prepared, s, SinCos::of(s * prepared.theta / 2),
+                                SinCos::of((1 - s) * prepared.theta / 2), r);
     }
   }
   const typename G::AdMatrix a = G::ad(x);
