@@ -649,6 +649,29 @@ TEST_CASE("non-convergence is reported in the status, with finite endpoints",
     REQUIRE(result.step_norms.size() == 3);
     REQUIRE(all_finite<G>(result));
   }
+  SECTION("divergence of the paper's step") {
+    // 6 rad of rotation on the universal cover (inside the series' disc),
+    // noisy, with lambda = 1.9 / mu_max: the linear part contracts by
+    // |1 - 1.9| = 0.9 in the fast direction, and the curvature term tips it
+    // over; the steps grow and the fit stops with `diverged`.
+    using G = CoverSE2;
+    std::vector<G::Element> f;
+    std::vector<double> t;
+    for (int i = 0; i < 20; ++i) {
+      const double s = i / 19.0, noise = (i % 3 - 1) * 0.5;
+      f.push_back(G::exp(G::Tangent(3 * s, 3 * noise, 6.0 * s + noise)));
+      t.push_back(s);
+    }
+    bireg::GeodesicRegression<G>::Options options;
+    options.solver = bireg::Solver::paper;
+    const double mu_max = bireg::GeodesicRegression<G>(options).fit(f, t).diagnostics.mu_max;
+    options.step_size = 1.9 / mu_max;
+    const auto result = bireg::GeodesicRegression<G>(options).fit(f, t);
+    REQUIRE(result.status == bireg::Status::diverged);
+    REQUIRE(result.geodesic.start().allFinite());
+    REQUIRE(result.geodesic.end().allFinite());
+    REQUIRE(std::isfinite(result.diagnostics.residual_rms));
+  }
   SECTION("geodesic beyond the series' radius of convergence") {
     using G = CoverSE2;
     STATIC_REQUIRE(bireg::is_lie_group_v<G>);
@@ -663,6 +686,41 @@ TEST_CASE("non-convergence is reported in the status, with finite endpoints",
     REQUIRE(result.status == bireg::Status::series_diverged);
     REQUIRE(result.geodesic.start().allFinite());
     REQUIRE(result.geodesic.end().allFinite());
+  }
+}
+
+// Duplicated covariates are allowed (several observations at one time), and
+// the order of the observations does not matter: a permutation changes only
+// the order of the sums. Run to tolerance 1e-14 (the returned endpoints are
+// then within ~1e-14 of the fixed point, not 1e-10), they agree to 1e-12.
+TEST_CASE("duplicated covariates are allowed and the order of observations does not matter",
+          "[regression]") {
+  using G = bireg::SE3<double>;
+  std::mt19937 rng(55);
+  Data<G> data = geodesic_data<G>(G::exp(random_tangent<G::Tangent>(rng, 1.0)),
+                                  random_tangent<G::Tangent>(rng, 0.8), 30, 0.05, rng);
+  for (int i = 0; i < 10; ++i)
+    data.t[i + 10] = data.t[10];  // ten observations share one time
+  bireg::GeodesicRegression<G>::Options options;
+  options.tolerance = 1e-14;
+  const bireg::GeodesicRegression<G> regression(options);
+  const auto base = regression.fit(data.f, data.t);
+  REQUIRE(base.ok());
+  std::vector<std::size_t> order(data.f.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::shuffle(order.begin(), order.end(), rng);
+  Data<G> shuffled;
+  for (std::size_t i : order) {
+    shuffled.f.push_back(data.f[i]);
+    shuffled.t.push_back(data.t[i]);
+  }
+  const auto permuted = regression.fit(shuffled.f, shuffled.t);
+  REQUIRE(permuted.ok());
+  REQUIRE(relative_error(permuted.geodesic.start(), base.geodesic.start()) <= 1e-12);
+  REQUIRE(relative_error(permuted.geodesic.end(), base.geodesic.end()) <= 1e-12);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    REQUIRE(relative_error(permuted.residuals[k], base.residuals[order[k]]) <= 1e-10);
   }
 }
 

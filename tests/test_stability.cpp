@@ -291,7 +291,8 @@ TEMPLATE_TEST_CASE("SE3 with metres of 1e6 next to rotations of 1e-6 rad", "[sta
 
 // float: the same kinds of case with float-scaled bounds. Length 1e-3 rad
 // noise-free: absolute slope error <= 16 eps_f; length 3.1: relative 1e-4
-// (the principal log near pi in float); ratio 1e-4 clustered converges and
+// (the principal log near pi in float); ratio 1e-4 clustered converges (the
+// slope to 64 eps_f: a few roundings of the two clusters' elements) and
 // ratio 1e-8 is below float's resolution of mu_min (16 eps_f mu_max) and is
 // refused as not identifiable.
 TEMPLATE_TEST_CASE("float keeps float-scaled accuracy", "[stability][float]", bireg::SO3<float>,
@@ -317,6 +318,26 @@ TEMPLATE_TEST_CASE("float keeps float-scaled accuracy", "[stability][float]", bi
     std::snprintf(line, sizeof line,
                   "| %s float long | length 3.1, noise-free | %s, %d it | %.2e relative |", G::name,
                   bireg::to_string(r.status), r.iterations, slope_error(c, r) / 3.1);
+    report(line);
+  }
+  {
+    // mu_min / mu_max = 1e-4 is resolved in float: converged, condition
+    // reported to float precision, slope exact to float rounding (noise-free).
+    Case<G> c = make_case<G>(1.0, 0.0, 50, 8);
+    c.w.assign(50, 1.0f);
+    c.w[49] = 1e-4f * 49;
+    for (int i = 0; i < 49; ++i) {
+      c.t[i] = 0.0f;
+      c.f[i] = c.g0;
+    }
+    const auto r = fit(c);
+    REQUIRE(r.ok());
+    REQUIRE(std::abs(r.diagnostics.condition_number * 1e-4 - 1) <= 1e-3);
+    REQUIRE(slope_error(c, r) <= 64 * eps<G>());
+    char line[160];
+    std::snprintf(line, sizeof line,
+                  "| %s float clustered | mu_min/mu_max 1e-4, noise-free | %s, %d it | %.2e |",
+                  G::name, bireg::to_string(r.status), r.iterations, slope_error(c, r));
     report(line);
   }
   {

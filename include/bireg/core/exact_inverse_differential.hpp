@@ -8,7 +8,12 @@
 //   psi_s(i theta)  = s^2 sin(theta/2) / sin(s theta/2) e^{-i (1-s) theta/2},
 //   psi_s'/psi_s    = (s - 1)/2 - (i/2) (cot(theta/2) - s cot(s theta/2)),
 //
-// both free of cancellation for s theta in (0, 2 pi). With F(i theta) =
+// both free of cancellation for s theta in (0, 2 pi). Domain: the rotation
+// angle theta in (0, 2 pi); the principal logarithm of SO(3), SE(3) and
+// SE(2) keeps it at or below pi, where sin(s theta/2) >= sin(s pi/2) > 0
+// for s > 0 (s = 0 returns psi_0 = 0 exactly). At theta -> 2 pi psi itself
+// has its pole (sin(theta/2) -> 0 in the denominator of cot(theta/2)), the
+// same edge where the series stops converging. With F(i theta) =
 // alpha + i beta and F'(i theta) = alpha' + i beta', the scalar coefficients
 //
 //   f1 = beta / theta,                     f2 = (s - alpha) / theta^2,
