@@ -540,6 +540,12 @@ class GeodesicRegression {
     return chart;
   }
 
+  // r_i = log(b_i^{-1} f_i), the residual of one observation at the
+  // prediction b_i = g0 exp(t_i X), with b_i^{-1} = exp(-t_i X) g0^{-1}.
+  static Tangent residual(const Element& g0_inverse, const Tangent& x, Scalar t, const Element& f) {
+    return G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, f)));
+  }
+
   // The net force of eq. "v" at (g0, g1), x = log(g0^{-1} g1), a = ad_x.
   //
   // Moment form: psi_s(z) = sum_m (-1)^m sum_k T[m][k] s^{k+1} z^m, and A is
@@ -553,7 +559,7 @@ class GeodesicRegression {
   template <class Observations>
   Force net_force(const Observations& observations, const Problem& problem, const Element& g0,
                   const Tangent& x, const AdMatrix& a, int order,
-                  std::vector<Tangent>* residuals = nullptr) const {
+                  std::vector<Tangent>& residuals) const {
     std::array<Tangent, kMaxSeriesOrder + 2> p, q;  // P_j, Q_j for j = 1 .. order + 1
     for (int j = 1; j <= order + 1; ++j) {
       p[j].setZero();
@@ -563,9 +569,8 @@ class GeodesicRegression {
     const std::size_t n = observations.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Scalar t = problem.t[i];
-      // r_i = log(b_i^{-1} f_i), b_i^{-1} = exp(-t_i X) g0^{-1}.
-      const Tangent r = G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, observations[i])));
-      if (residuals) (*residuals)[i] = r;
+      const Tangent r = residual(g0_inverse, x, t, observations[i]);
+      residuals[i] = r;
       Scalar t_power = problem.w[i];
       Scalar one_minus_t_power = problem.w[i];
       for (int j = 1; j <= order + 1; ++j) {
@@ -605,7 +610,7 @@ class GeodesicRegression {
     const std::size_t n = observations.size();
     for (std::size_t i = 0; i < n; ++i) {
       const Scalar t = problem.t[i], w = problem.w[i];
-      const Tangent r = G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, observations[i])));
+      const Tangent r = residual(g0_inverse, x, t, observations[i]);
       residuals[i] = r;
       const SinCos t_half = SinCos::of(t * forward.theta / 2);
       const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
@@ -660,7 +665,7 @@ class GeodesicRegression {
       }
     }
     std::tie(state.order, state.truncation) = series_order(state.a);
-    state.force = net_force(observations, problem, g0, state.x, state.a, state.order, &residuals);
+    state.force = net_force(observations, problem, g0, state.x, state.a, state.order, residuals);
     return state;
   }
 
@@ -821,8 +826,7 @@ class GeodesicRegression {
     } else {  // no force to report (0); the residuals need no series
       const Element g0_inverse = G::inverse(state.g0);
       for (std::size_t i = 0; i < n; ++i) {
-        result.residuals[i] = G::log(
-            G::compose(G::exp(-problem.t[i] * state.x), G::compose(g0_inverse, observations[i])));
+        result.residuals[i] = residual(g0_inverse, state.x, problem.t[i], observations[i]);
       }
     }
     const std::size_t steps = result.step_norms.size();
