@@ -1,10 +1,12 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
-//   bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum] [--method exact|series|series_adaptive]
-//             [--order M] [--solver paper|optimal_linear|preconditioned|gauss_newton]
+//   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum]
+//             [--method exact|series|series_adaptive] [--order M] [--solver
+//             paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--output-trajectory FILE] FILE|-
 //
+// Sim3 (4x4 [s R t; 0 1]), SL3 and GLp3 (3x3) read the matrix format only.
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
 //
@@ -20,8 +22,10 @@
 #include <string>
 #include <vector>
 
+#include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
@@ -33,7 +37,7 @@ constexpr int kExitInvalid = 2;
 constexpr int kExitNotConverged = 3;
 
 constexpr const char* kUsage =
-    "usage: bireg_fit --group SO2|SO3|SE2|SE3 [--format matrix|tum]\n"
+    "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum]\n"
     "                 [--method exact|series|series_adaptive] [--order M]\n"
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
@@ -234,7 +238,10 @@ int main(int argc, char** argv) {
   if (command.group == "SO3") return run<bireg::SO3<double>>(command);
   if (command.group == "SE2") return run<bireg::SE2<double>>(command);
   if (command.group == "SE3") return run<bireg::SE3<double>>(command);
-  std::fprintf(stderr, "bireg_fit: unknown group '%s' (SO2, SO3, SE2 or SE3)\n%s",
+  if (command.group == "Sim3") return run<bireg::Sim3<double>>(command);
+  if (command.group == "SL3") return run<bireg::SL3<double>>(command);
+  if (command.group == "GLp3") return run<bireg::GLp<3, double>>(command);
+  std::fprintf(stderr, "bireg_fit: unknown group '%s' (SO2, SO3, SE2, SE3, Sim3, SL3 or GLp3)\n%s",
                command.group.c_str(), kUsage);
   return kExitInvalid;
 }

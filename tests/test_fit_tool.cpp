@@ -12,8 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
@@ -157,6 +159,9 @@ TEST_CASE("bireg_fit reads both formats and agrees with the library", "[tool]") 
                                             "--group SO3 --format tum");
   check_against_library<bireg::SE2<double>>("se2_small.csv", Format::matrix, "--group SE2");
   check_against_library<bireg::SO2<double>>("so2_small.csv", Format::matrix, "--group SO2");
+  check_against_library<bireg::Sim3<double>>("sim3_small.csv", Format::matrix, "--group Sim3");
+  check_against_library<bireg::SL3<double>>("sl3_small.csv", Format::matrix, "--group SL3");
+  check_against_library<bireg::GLp<3, double>>("glp3_small.csv", Format::matrix, "--group GLp3");
 }
 
 TEST_CASE("bireg_fit reads standard input", "[tool]") {
@@ -211,6 +216,17 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
       {"--group SO3 --order 8", "so3_small.csv", "--order applies to --method series only"},
       {"--group SO3 --method taylor", "so3_small.csv", "unknown method 'taylor'"},
       {"--group SO3 --solver newton", "so3_small.csv", "unknown solver 'newton'"},
+      {"--group Sim3", "sim3_not_in_group.csv",
+       "sim3_not_in_group.csv:3: matrix is not an element of Sim3"},
+      {"--group SL3", "sl3_not_in_group.csv",
+       "sl3_not_in_group.csv:4: matrix is not an element of SL3"},
+      {"--group GLp3", "glp3_not_in_group.csv",
+       "glp3_not_in_group.csv:2: matrix is not an element of GLp"},
+      {"--group Sim3", "so3_small.csv", "so3_small.csv:3: expected 17 numbers, found 10"},
+      {"--group SL3 --format tum", "se3_small.tum",
+       "the tum format holds SE3 or SO3 poses, not SL3"},
+      {"--group SL3", "sl3_no_logarithm.csv",
+       "sl3_no_logarithm.csv:5: observation 4 is out of reach of the middle observation"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.args, c.file);

@@ -17,6 +17,7 @@
 #include "bireg/groups/rn.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "catch.hpp"
@@ -46,7 +47,8 @@ long double tolerance(long double scale = 1) {
   bireg::SO2<float>, bireg::SO2<double>, bireg::SO2<long double>, bireg::SO3<float>,           \
       bireg::SO3<double>, bireg::SO3<long double>, bireg::SE2<float>, bireg::SE2<double>,      \
       bireg::SE2<long double>, bireg::SE3<float>, bireg::SE3<double>, bireg::SE3<long double>, \
-      (bireg::Rn<3, float>), (bireg::Rn<3, double>), (bireg::Rn<3, long double>)
+      (bireg::Rn<3, float>), (bireg::Rn<3, double>), (bireg::Rn<3, long double>),              \
+      bireg::Sim3<float>, bireg::Sim3<double>, bireg::Sim3<long double>
 
 TEMPLATE_TEST_CASE("every group satisfies the concept", "[groups]", BIREG_ALL_GROUPS) {
   STATIC_REQUIRE(bireg::check_lie_group<TestType>());
@@ -154,7 +156,7 @@ TEMPLATE_TEST_CASE("commutative groups have ad = 0", "[groups]", bireg::SO2<doub
 
 TEMPLATE_TEST_CASE("is_element accepts near-group matrices and rejects far ones", "[groups]",
                    bireg::SO2<double>, bireg::SO3<double>, bireg::SE2<double>, bireg::SE3<double>,
-                   bireg::SO3<float>, bireg::SE3<float>) {
+                   bireg::SO3<float>, bireg::SE3<float>, bireg::Sim3<double>, bireg::Sim3<float>) {
   using G = TestType;
   using Scalar = typename G::Scalar;
   using Element = typename G::Element;
@@ -181,8 +183,9 @@ TEMPLATE_TEST_CASE("is_element accepts near-group matrices and rejects far ones"
   not_finite(0, 1) = std::numeric_limits<Scalar>::quiet_NaN();
   REQUIRE_FALSE(G::is_element(not_finite));
 
-  constexpr bool homogeneous =
-      std::is_same_v<G, bireg::SE2<Scalar>> || std::is_same_v<G, bireg::SE3<Scalar>>;
+  constexpr bool homogeneous = std::is_same_v<G, bireg::SE2<Scalar>> ||
+                               std::is_same_v<G, bireg::SE3<Scalar>> ||
+                               std::is_same_v<G, bireg::Sim3<Scalar>>;
   if constexpr (homogeneous) {
     Element bad_last_row = g;
     bad_last_row(G::matrix_size - 1, 0) = Scalar(0.5);

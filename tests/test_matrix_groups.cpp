@@ -1,6 +1,7 @@
 // MatrixGroup<N, Basis>: the algebraic identities of test_groups.cpp on the
 // Heisenberg group, SL(3) and GL+(3), the Heisenberg group's polynomial
-// closed forms and terminating series, and the regression on them.
+// closed forms and terminating series, exp/log from tiny to near the branch
+// cut, and the log's domain (the regression on them: test_scene_groups.cpp).
 //
 // Tolerance: Eigen's matrix exponential (Pade with scaling and squaring)
 // and logarithm (Schur-Parlett with inverse scaling and squaring) are
@@ -8,7 +9,10 @@
 // entries up to 0.5, so no eigenvalue near the log's branch cut); identities
 // that chain two or three of them are allowed 1e-12 relative, ~5000 epsilon,
 // far below the O(1) error of a wrong sign or basis.
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "bireg/core/concept.hpp"
 #include "bireg/core/exact_inverse_differential.hpp"
@@ -79,42 +83,80 @@ TEST_CASE("Heisenberg: polynomial exp and log, nilpotent ad, terminating series"
   }
 }
 
-// Noise-free recovery and left/right/inverse equivariance of the fit on the
-// matrix groups (tolerance 1e-13 on the step; the matrix functions' ~1e-13
-// accuracy then bounds the agreement: 1e-9).
-TEMPLATE_TEST_CASE("regression on matrix groups", "[matrix_group][regression]",
-                   bireg::Heisenberg<double>, bireg::SL3<double>) {
+// Extreme sizes: tangent vectors t u with u a random unit (Frobenius) algebra
+// element, t from 0 and 1e-300 up to 3 (the eigenvalues of t hat(u) stay
+// below t < pi in modulus, inside the principal log's domain), and the
+// rotation generator alone at pi - 1e-k. exp is compared with the long
+// double reference; log(exp(x)) with x. Eigen's exp is accurate to a few
+// hundred epsilon at these norms and its log is backward stable, so the
+// forward error of log is its condition number (~1/(pi - t) near the branch
+// cut, where two eigenvalues approach -1 from both sides) times that:
+// tolerance 1e-12 / (pi - t) relative, capped below by 1e-12.
+TEMPLATE_TEST_CASE("matrix groups: exp and log from tiny to near the branch cut",
+                   "[matrix_group][accuracy]", bireg::SL3<double>, (bireg::GLp<3, double>)) {
   using G = TestType;
-  std::mt19937 rng(93);
-  const typename G::Element g0 = G::exp(random_tangent<typename G::Tangent>(rng, kScale));
-  const typename G::Tangent x = random_tangent<typename G::Tangent>(rng, kScale);
-  const typename G::Element h = G::exp(random_tangent<typename G::Tangent>(rng, kScale));
-  std::vector<typename G::Element> f, noisy, left, right, inverted;
-  std::vector<double> t;
-  for (int i = 0; i < 25; ++i) {
-    const double s = i / 24.0;
-    f.push_back(G::compose(g0, G::exp(s * x)));
-    noisy.push_back(G::compose(f.back(), G::exp(random_tangent<typename G::Tangent>(rng, 0.05))));
-    left.push_back(G::compose(h, noisy.back()));
-    right.push_back(G::compose(noisy.back(), h));
-    inverted.push_back(G::inverse(noisy.back()));
-    t.push_back(s);
+  using Tangent = typename G::Tangent;
+  using LongMatrix = Eigen::Matrix<long double, 3, 3>;
+  const double pi = 3.141592653589793;
+  std::mt19937 rng(94);
+  for (double size : {0.0, 1e-300, 1e-16, 1e-12, 1e-8, 1e-4, 0.1, 1.0, 2.0, 3.0}) {
+    for (int sample = 0; sample < 10; ++sample) {
+      Tangent u = random_tangent<Tangent>(rng, 1.0);
+      u /= G::hat(u).norm();
+      const Tangent x = size * u;
+      CAPTURE(size);
+      const LongMatrix reference =
+          bireg_test::reference_expm<3>(LongMatrix(G::hat(x).template cast<long double>()));
+      REQUIRE(relative_error(G::exp(x), reference) <= 1e-13);
+      const Tangent back = G::log(G::exp(x));
+      REQUIRE(back.allFinite());
+      // Absolute below size 1 (the identity's rounding is absolute), relative above.
+      REQUIRE((back - x).cwiseAbs().maxCoeff() <= 1e-12 * std::max(1.0, size) / (pi - size));
+    }
   }
-  typename bireg::GeodesicRegression<G>::Options options;
-  options.tolerance = 1e-13;
-  const bireg::GeodesicRegression<G> regression(options);
-  const auto exact = regression.fit(f, t);
-  REQUIRE(exact.ok());
-  REQUIRE(relative_error(exact.geodesic.start(), g0) <= 1e-9);
-  REQUIRE(relative_error(exact.geodesic.end(), G::compose(g0, G::exp(x))) <= 1e-9);
+  // The rotation about z inside SL(3) / GL+(3), by pi - 1e-k.
+  Eigen::Matrix3d skew = Eigen::Matrix3d::Zero();
+  skew(0, 1) = -1;
+  skew(1, 0) = 1;
+  const Tangent axis = G::vee(skew);
+  for (int k = 1; k <= 8; ++k) {
+    const double angle = pi - std::pow(10.0, -k);
+    CAPTURE(angle);
+    const Tangent back = G::log(G::exp(angle * axis));
+    REQUIRE(back.allFinite());
+    REQUIRE((back - angle * axis).cwiseAbs().maxCoeff() <= 1e-12 * pi / (pi - angle));
+  }
+}
 
-  const auto base = regression.fit(noisy, t);
-  const auto l = regression.fit(left, t);
-  const auto r = regression.fit(right, t);
-  const auto v = regression.fit(inverted, t);
-  REQUIRE((base.ok() && l.ok() && r.ok() && v.ok()));
-  REQUIRE(relative_error(l.geodesic.start(), G::compose(h, base.geodesic.start())) <= 1e-9);
-  REQUIRE(relative_error(r.geodesic.end(), G::compose(base.geodesic.end(), h)) <= 1e-9);
-  REQUIRE(relative_error(v.geodesic.start(), G::inverse(base.geodesic.start())) <= 1e-9);
-  REQUIRE(relative_error(v.geodesic.end(), G::inverse(base.geodesic.end())) <= 1e-9);
+// Outside the principal log's domain Eigen's log is not a logarithm; bireg
+// returns NaN there and the fit names the observation.
+TEST_CASE("matrix groups: log outside its domain is NaN, and the fit says so",
+          "[matrix_group][errors]") {
+  using G = bireg::SL3<double>;
+  const G::Element negative = Eigen::Vector3d(-2.0, -0.5, 1.0).asDiagonal();
+  REQUIRE(G::is_element(negative));
+  REQUIRE(G::log(negative).array().isNaN().all());
+  // Just inside: a rotation by pi - 1e-3 has a (finite) principal log.
+  G::Tangent x = G::Tangent::Zero();
+  x[0] = -(3.141592653589793 - 1e-3);  // E01 coefficient -theta, E10 +theta
+  x[2] = 3.141592653589793 - 1e-3;
+  REQUIRE(G::log(G::exp(x)).allFinite());
+
+  std::vector<G::Element> f;
+  std::vector<double> t;
+  for (int i = 0; i < 5; ++i) {
+    G::Tangent y = G::Tangent::Zero();
+    y[0] = -0.1 * i;
+    y[2] = 0.1 * i;
+    f.push_back(i == 4 ? negative : G::exp(y));
+    t.push_back(i);
+  }
+  const auto result = bireg::GeodesicRegression<G>().fit(f, t);
+  REQUIRE(result.status == bireg::Status::invalid_input);
+  REQUIRE(result.bad_index == 4);
+  REQUIRE(result.message.find("observation 4 is out of reach") != std::string::npos);
+
+  // The Heisenberg group declares that its log exists everywhere.
+  const bireg::Heisenberg<double>::Element h = bireg::Heisenberg<double>::exp({1e3, -1e3, 5.0});
+  REQUIRE(bireg::Heisenberg<double>::log(h).allFinite());
 }

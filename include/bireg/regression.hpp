@@ -76,7 +76,10 @@ enum class Status {
                     // differentials' series no longer converges
   stalled,          // the safeguard found no step that decreases ||v||: the data
                     // lie outside the region where the estimator is defined
-                    // (e.g. a rotation of more than pi along the geodesic)
+                    // (e.g. a rotation of more than pi along the geodesic);
+                    // or, at the rounding level (sqrt(epsilon) relative to
+                    // |X|), the steps stopped shrinking for kStallIterations:
+                    // the tolerance is finer than the data's rounding allows
   invalid_input,    // rejected before any work; see Result::message
 };
 
@@ -153,6 +156,13 @@ inline const char* to_string(Solver solver) {
 // much and nothing else.
 inline constexpr int kGaussNewtonOrder = 16;
 
+// Iterations without a new smallest step, all below the rounding level,
+// after which a fit stops with Status::stalled. Every solver shrinks its
+// step at least linearly while it can, so 10 iterations with no progress
+// mean rounding dominates: e.g. similarities at scale e^-20 carrying an
+// O(1) translation keep only ~1e-7 of their detail in double.
+inline constexpr int kStallIterations = 10;
+
 template <class G>
 class GeodesicRegression {
   static_assert(check_lie_group<G>());
@@ -181,7 +191,10 @@ class GeodesicRegression {
     // solvers fix their own step, so a non-zero value is refused for them.
     Scalar step_size = Scalar(0);
     // Converged when the norm of the step (lambda v0, lambda v1), in
-    // tangent coordinates, is at or below this.
+    // tangent coordinates, is at or below this. It is absolute: data whose
+    // tangent coordinates are large (e.g. translations in millimetres) need
+    // a proportionally larger value. 0 runs exactly max_iterations
+    // iterations (no convergence or stall test), unless the fit diverges.
     Scalar tolerance = std::max(Scalar(1e-10), Scalar(64) * std::numeric_limits<Scalar>::epsilon());
     int max_iterations = 1000;
     // Endpoints at the smallest and largest covariate to start from; by
@@ -263,6 +276,15 @@ class GeodesicRegression {
     result.diagnostics.step_size = problem.lambda;
 
     const Chart chart = chart_fit(observations, problem);
+    if (chart.no_logarithm >= 0) {
+      reject(result,
+             "observation " + std::to_string(chart.no_logarithm) +
+                 " is out of reach of the middle observation: no principal logarithm of "
+                 "f_mid^{-1} f_i (the data leave the domain of " +
+                 G::name + "'s log)",
+             chart.no_logarithm);
+      return result;
+    }
     Element g0 = chart.g0, g1 = chart.g1;
     if (options_.initial_guess) {
       g0 = options_.initial_guess->first;
@@ -509,6 +531,7 @@ class GeodesicRegression {
   struct Chart {
     Element g0, g1;
     Scalar spread = 0;
+    std::ptrdiff_t no_logarithm = -1;  // an observation whose log was not finite
   };
 
   template <class Observations>
@@ -525,6 +548,11 @@ class GeodesicRegression {
     Scalar square_sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
+      if (!y.allFinite()) {
+        Chart outside;
+        outside.no_logarithm = index(i);
+        return outside;
+      }
       moment0 += problem.w[i] * (1 - problem.t[i]) * y;
       moment1 += problem.w[i] * problem.t[i] * y;
       square_sum += problem.w[i] * y.squaredNorm();
@@ -749,6 +777,7 @@ class GeodesicRegression {
         kDivergenceGrowth *
         std::max(options_.tolerance, sqrt(std::numeric_limits<Scalar>::epsilon()));
     constexpr int kMaxHalvings = 20;
+    int iterations_without_progress = 0;
 
     result.step_norms.reserve(static_cast<std::size_t>(options_.max_iterations));
     if (options_.record_iterates) {
@@ -774,7 +803,19 @@ class GeodesicRegression {
         result.status = Status::diverged;
         return state;
       }
-      smallest_step = std::min(smallest_step, step_norm);
+      // Steps below sqrt(epsilon) relative to the geodesic's size are at
+      // the rounding level, where they fluctuate without meaning.
+      const Scalar rounding_level =
+          std::max(options_.tolerance, sqrt(std::numeric_limits<Scalar>::epsilon()) *
+                                           std::max(Scalar(1), sqrt(state.x.squaredNorm())));
+      if (step_norm < smallest_step) {
+        smallest_step = step_norm;
+        iterations_without_progress = 0;
+      } else if (options_.tolerance > 0 && step_norm <= rounding_level &&
+                 ++iterations_without_progress >= kStallIterations) {
+        result.status = Status::stalled;
+        return state;
+      }
       result.step_norms.push_back(step_norm);
       result.iterations = iteration + 1;
       // The step proposed at the current endpoints certifies them: it is
@@ -801,11 +842,18 @@ class GeodesicRegression {
         // Every halving failed: no step along this direction decreases the
         // force. Above the rounding level that means the data are outside
         // the estimator's domain; stop rather than wander.
-        if (!acceptable(next) && step_norm > divergence_floor / kDivergenceGrowth) {
+        if (!acceptable(next) && step_norm > rounding_level) {
           result.status = Status::stalled;
           evaluate(observations, problem, state.g0, state.g1, result.residuals);
           return state;
         }
+      }
+      // A non-finite force: the step left the domain of the group's log
+      // (MatrixGroup returns NaN there). Keep the last finite endpoints.
+      if (next.series_converges && (!next.force.v0.allFinite() || !next.force.v1.allFinite())) {
+        result.status = Status::diverged;
+        evaluate(observations, problem, state.g0, state.g1, result.residuals);
+        return state;
       }
       state = next;
       if (options_.record_iterates) result.iterates.emplace_back(state.g0, state.g1);

@@ -11,16 +11,24 @@
 //   static constexpr const char* name;
 //   template <class S> static Eigen::Matrix<S, N, N> generator(int k);   // k < dof
 //   template <class S> static bool is_element(const Eigen::Matrix<S, N, N>&, S tol);
+// and optionally `static constexpr bool log_everywhere` (below)
 // (see HeisenbergBasis, SL3Basis, GLBasis below: a dozen lines each).
 //
 // Domain of log: the principal matrix logarithm exists for matrices with no
 // eigenvalue on the closed negative real axis; there it is the unique
 // logarithm whose eigenvalues have imaginary parts in (-pi, pi). Outside it
-// (e.g. a rotation by exactly pi inside SL(3), or a negative eigenvalue)
-// Eigen's result is not a real logarithm of the input: check
-// exp(log(g)) = g when data may get there. Prefer the closed-form groups
-// (SO3, SE3, ...) where they exist: they are exact to rounding and much
-// faster.
+// (a rotation by pi inside SL(3), a negative eigenvalue) Eigen returns the
+// real part of a complex logarithm, which is no logarithm of the input at
+// all. MatrixGroup::log therefore checks exp(log g) = g (to sqrt(epsilon)
+// relative; outside the domain the mismatch is O(1)) and returns a tangent
+// of NaN when it fails. GeodesicRegression turns that into a status: data
+// that leave the domain as seen from their middle observation are
+// invalid_input (naming the observation); an iterate that leaves it stops
+// the fit with diverged and the last finite endpoints. A basis whose group
+// has a logarithm everywhere (unipotent groups such as Heisenberg) may
+// declare `static constexpr bool log_everywhere = true;` to skip the check.
+// Prefer the closed-form groups (SO3, SE3, Sim3, ...) where they exist: they
+// are exact to rounding and much faster.
 //
 // The matrix functions allocate internally (dynamic Schur decompositions),
 // so fits on a MatrixGroup are not allocation-free, unlike the closed-form
@@ -29,6 +37,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <type_traits>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -56,7 +66,20 @@ struct MatrixGroup {
   static Element inverse(const Element& g) { return g.inverse(); }
 
   static Element exp(const Tangent& x) { return Element(hat(x).exp()); }
-  static Tangent log(const Element& g) { return vee(Algebra(g.log())); }
+
+  // The principal logarithm, or NaN outside its domain (see above).
+  static Tangent log(const Element& g) {
+    using std::sqrt;
+    const Algebra logarithm = g.log();
+    if constexpr (!log_everywhere()) {
+      const Scalar mismatch = (Element(logarithm.exp()) - g).cwiseAbs().maxCoeff();
+      const Scalar size = g.cwiseAbs().maxCoeff();
+      if (!(mismatch <= sqrt(std::numeric_limits<Scalar>::epsilon()) * size)) {
+        return Tangent::Constant(std::numeric_limits<Scalar>::quiet_NaN());
+      }
+    }
+    return vee(logarithm);
+  }
 
   static Algebra hat(const Tangent& x) {
     Algebra m = Algebra::Zero();
@@ -98,6 +121,13 @@ struct MatrixGroup {
   }
 
  private:
+  template <class B, class = void>
+  struct declares_log_everywhere : std::false_type {};
+  template <class B>
+  struct declares_log_everywhere<B, std::void_t<decltype(B::log_everywhere)>>
+      : std::bool_constant<B::log_everywhere> {};
+  static constexpr bool log_everywhere() { return declares_log_everywhere<Basis>::value; }
+
   // (B^T B)^{-1} B^T with B = [vec E_1 ... vec E_dof], computed once.
   static const Eigen::Matrix<Scalar, dof, N * N>& projector() {
     static const Eigen::Matrix<Scalar, dof, N* N> p = [] {
@@ -119,6 +149,7 @@ struct MatrixGroup {
 struct HeisenbergBasis {
   static constexpr int dof = 3;
   static constexpr const char* name = "Heisenberg";
+  static constexpr bool log_everywhere = true;  // unipotent: log is a polynomial
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {
     Eigen::Matrix<S, 3, 3> e = Eigen::Matrix<S, 3, 3>::Zero();

@@ -1,5 +1,6 @@
-// bireg: the direct product G1 x G2 of two groups (nest for more:
-// Product<G1, Product<G2, G3>>).
+// bireg: the direct product G1 x G2 x ... of groups. Product<G1, G2, G3>
+// is Product<G1, Product<G2, G3>>: its elements nest the same way
+// (g.second.first is the G2 component).
 //
 // Everything acts component-wise: (a1, a2)(b1, b2) = (a1 b1, a2 b2), exp and
 // log per component, tangent vectors concatenated (G1's coordinates first),
@@ -37,8 +38,11 @@ struct ProductAlgebra {
   A2 second;
 };
 
+template <class G1, class G2, class... More>
+struct Product : Product<G1, Product<G2, More...>> {};
+
 template <class G1, class G2>
-struct Product {
+struct Product<G1, G2> {
   static_assert(std::is_same_v<typename G1::Scalar, typename G2::Scalar>,
                 "Product<G1, G2>: both factors need the same Scalar");
   using Scalar = typename G1::Scalar;
