@@ -18,6 +18,10 @@
 //   B5  BM_Precision/<scalar>       SE(3), N = 1000, length 1.5, noise 0.05:
 //                                   float against double, time and
 //                                   `endpoint_error` against the same reference
+//   B6  BM_Scene<group>             every group, N = 1000, length 1, noise
+//                                   0.1, default method, 20 paper iterations:
+//                                   the per-observation-iteration cost of the
+//                                   scene groups next to SE(3)'s
 //
 // Counters: `iterations` per fit; `time_per_obs_iter` = fit time / (N x
 // iterations), in seconds (printed with an SI prefix: 308n = 308 ns).
@@ -30,8 +34,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bireg/groups/matrix_group.hpp"
+#include "bireg/groups/product.hpp"
+#include "bireg/groups/rn.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 
@@ -215,6 +223,26 @@ void BM_Precision(benchmark::State& state) {
 }
 BENCHMARK_TEMPLATE(BM_Precision, float)->Unit(benchmark::kMicrosecond);
 BENCHMARK_TEMPLATE(BM_Precision, double)->Unit(benchmark::kMicrosecond);
+
+// B6: the loop's cost on every scene group at the default method (closed
+// form where the group has one, the adaptive series elsewhere), as B1.
+template <class G>
+void BM_Scene(benchmark::State& state) {
+  static const Problem<G> problem = make_problem<G>(1000, 1.0, 0.1, 5);
+  typename bireg::GeodesicRegression<G>::Options options;
+  options.solver = bireg::Solver::paper;
+  options.tolerance = 0;
+  options.max_iterations = 20;
+  state.SetLabel(G::name);
+  run_fits(state, problem, options);
+}
+BENCHMARK_TEMPLATE(BM_Scene, bireg::SE3<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Scene, bireg::Sim3<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Scene, bireg::Product<bireg::SO3<double>, bireg::Rn<3, double>>)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Scene, bireg::Heisenberg<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Scene, bireg::SL3<double>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Scene, bireg::GLp<3, double>)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -83,6 +83,15 @@ def main(folder):
         if m:
             print(f"| {m.group(1)} | {fmt_time(seconds(b))} | {int(b['iterations'])} | {b['endpoint_error']:.2e} |")
 
+    print("\n### B6: every group, per observation and iteration (paper solver, N = 1000, length 1)\n")
+    print("| group | time per observation-iteration | vs SE3 |\n|---|---|---|")
+    scene = {}
+    for name, b in runs.items():
+        if name.startswith("BM_Scene<"):
+            scene[b.get("label", name)] = b["time_per_obs_iter"]
+    for label, t in scene.items():
+        print(f"| {label} | {fmt_time(t)} | {t / scene['SE3']:.2f} |")
+
     print("\n### B2: accuracy against time (N = 100, noise 0.05, gauss_newton)\n")
     print("| group | length | method | tolerance | endpoint error | time |\n|---|---|---|---|---|---|")
     points = []
