@@ -682,10 +682,25 @@ TEST_CASE("non-convergence is reported in the status, with finite endpoints",
       f.push_back(G::exp(G::Tangent(1.0 * s, 0.5, 8.0 * s)));  // 8 rad > 2 pi of rotation
       t.push_back(s);
     }
-    const auto result = bireg::GeodesicRegression<G>().fit(f, t);
-    REQUIRE(result.status == bireg::Status::series_diverged);
-    REQUIRE(result.geodesic.start().allFinite());
-    REQUIRE(result.geodesic.end().allFinite());
+    // The least-squares start lies beyond the disc, so the fit restarts
+    // from the middle observation. The paper's unguarded step then walks
+    // out of the disc and stops with series_diverged; Gauss-Newton's
+    // safeguard refuses every step that would leave it and stops with
+    // stalled. Both return the last endpoints inside the disc.
+    bireg::GeodesicRegression<G>::Options paper;
+    paper.solver = bireg::Solver::paper;
+    const auto unguarded = bireg::GeodesicRegression<G>(paper).fit(f, t);
+    const auto guarded = bireg::GeodesicRegression<G>().fit(f, t);
+    REQUIRE(unguarded.status == bireg::Status::series_diverged);
+    REQUIRE(guarded.status == bireg::Status::stalled);
+    for (const auto* result : {&unguarded, &guarded}) {
+      REQUIRE(result->geodesic.start().allFinite());
+      REQUIRE(result->geodesic.end().allFinite());
+      REQUIRE(bireg::ad_spectral_radius<G>(G::log(
+                  G::compose(G::inverse(result->geodesic.start()), result->geodesic.end()))) <
+              2 * 3.141592653589793);
+      REQUIRE(std::isfinite(result->diagnostics.residual_rms));
+    }
   }
 }
 

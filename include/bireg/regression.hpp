@@ -72,8 +72,9 @@ enum class Status {
   converged,        // step norm at or below the tolerance
   max_iterations,   // iteration limit reached first; the last iterate is returned
   diverged,         // the steps grew without bound (or became non-finite)
-  series_diverged,  // spectral radius of ad_X reached 2 pi: the inverse
-                    // differentials' series no longer converges
+  series_diverged,  // a step would take the spectral radius of ad_X to 2 pi,
+                    // where the inverse differentials' series no longer
+                    // converges; the last endpoints inside are returned
   stalled,          // the safeguard found no step that decreases ||v||: the data
                     // lie outside the region where the estimator is defined
                     // (e.g. a rotation of more than pi along the geodesic);
@@ -199,6 +200,9 @@ class GeodesicRegression {
     int max_iterations = 1000;
     // Endpoints at the smallest and largest covariate to start from; by
     // default the linearised least-squares fit described at initial_guess().
+    // A start whose geodesic leaves the series' disc (spectral radius of
+    // ad_X >= 2 pi) or the domain of the group's log is replaced by the
+    // observation nearest the middle covariate, as a constant geodesic.
     std::optional<std::pair<Element, Element>> initial_guess;
     // Non-negative weight per observation; empty means all 1.
     std::vector<Scalar> weights;
@@ -290,7 +294,7 @@ class GeodesicRegression {
       g0 = options_.initial_guess->first;
       g1 = options_.initial_guess->second;
     }
-    const State final_state = iterate(observations, problem, g0, g1, result);
+    const State final_state = iterate(observations, problem, g0, g1, chart.reference, result);
     finish(observations, problem, final_state, chart.spread, result);
     return result;
   }
@@ -530,6 +534,7 @@ class GeodesicRegression {
   //    bi-invariant mean up to terms of third order in the data's radius.
   struct Chart {
     Element g0, g1;
+    Element reference;  // the observation nearest the middle of the covariates
     Scalar spread = 0;
     std::ptrdiff_t no_logarithm = -1;  // an observation whose log was not finite
   };
@@ -550,6 +555,7 @@ class GeodesicRegression {
       const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
       if (!y.allFinite()) {
         Chart outside;
+        outside.g0 = outside.g1 = outside.reference = f_ref;
         outside.no_logarithm = index(i);
         return outside;
       }
@@ -562,6 +568,7 @@ class GeodesicRegression {
     const Tangent x1 = (problem.a * moment1 - problem.b * moment0) / determinant;
     const Tangent total = moment0 + moment1;  // sum w y
     Chart chart;
+    chart.reference = f_ref;
     chart.g0 = exp_at<G>(f_ref, x0);
     chart.g1 = exp_at<G>(f_ref, x1);
     chart.spread = std::max(Scalar(0), square_sum - total.squaredNorm() / problem.weight_sum);
@@ -764,8 +771,13 @@ class GeodesicRegression {
   // endpoints; result.residuals hold the residuals there (unless the series did not converge at
   // that state).
   template <class Observations>
+  //
+  // Every state it returns has a convergent series and a finite force, hence
+  // finite residuals, except when even the fallback start (the middle
+  // observation as a constant model, whose residuals the chart fit checked)
+  // is unusable, which cannot happen: there X = 0.
   State iterate(const Observations& observations, const Problem& problem, const Element& start0,
-                const Element& start1, Result& result) const {
+                const Element& start1, const Element& fallback, Result& result) const {
     using std::isfinite;
     using std::sqrt;
     // A step this much larger than the smallest one seen means the
@@ -787,7 +799,15 @@ class GeodesicRegression {
     result.residuals.resize(observations.size());
     const bool safeguarded = options_.solver != Solver::paper;
     Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
+    const auto usable = [](const State& s) {
+      return s.series_converges && s.force.v0.allFinite() && s.force.v1.allFinite();
+    };
     State state = evaluate(observations, problem, start0, start1, result.residuals);
+    // A start beyond the series' disc or the log's domain (an extrapolated
+    // chart line on a matrix group, a far initial guess): start from the
+    // middle observation instead.
+    if (!usable(state))
+      state = evaluate(observations, problem, fallback, fallback, result.residuals);
     for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
       if (!state.series_converges) {
         result.status = Status::series_diverged;
@@ -848,10 +868,11 @@ class GeodesicRegression {
           return state;
         }
       }
-      // A non-finite force: the step left the domain of the group's log
-      // (MatrixGroup returns NaN there). Keep the last finite endpoints.
-      if (next.series_converges && (!next.force.v0.allFinite() || !next.force.v1.allFinite())) {
-        result.status = Status::diverged;
+      // The step left the series' disc, or the domain of the group's log
+      // (MatrixGroup returns NaN there, so the force is not finite). Keep
+      // the last usable endpoints.
+      if (!usable(next)) {
+        result.status = next.series_converges ? Status::diverged : Status::series_diverged;
         evaluate(observations, problem, state.g0, state.g1, result.residuals);
         return state;
       }

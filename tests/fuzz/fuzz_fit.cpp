@@ -1,7 +1,8 @@
 // libFuzzer target: the trajectory parser and fit() on whatever it accepts.
 //
-// The first byte of the input selects the group and format; the rest is the
-// file's text. Properties checked (abort = finding):
+// The first byte of the input selects the group (bits 0, 1, 4: SO2, SO3,
+// SE2, SE3, Sim3, SL3, GLp3, Heisenberg), the format (bit 2) and the solver
+// (bit 3); the rest is the file's text. Properties checked (abort = finding):
 //   * the parser never crashes and either reports an error with a line
 //     number inside the text or returns observations in the group;
 //   * fit() on parsed input never crashes, never returns NaN or infinity
@@ -19,8 +20,10 @@
 #include <sstream>
 #include <string>
 
+#include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
@@ -71,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
   const auto format = (selector & 4) ? bireg::tools::Format::tum : bireg::tools::Format::matrix;
   const auto solver = (selector & 8) ? bireg::Solver::paper : bireg::Solver::gauss_newton;
-  switch (selector & 3) {
+  switch ((selector & 3) | ((selector >> 2) & 4)) {  // bits 0, 1 and 4
     case 0:
       exercise<bireg::SO2<double>>(text, format, solver);
       break;
@@ -81,8 +84,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case 2:
       exercise<bireg::SE2<double>>(text, format, solver);
       break;
-    default:
+    case 3:
       exercise<bireg::SE3<double>>(text, format, solver);
+      break;
+    case 4:
+      exercise<bireg::Sim3<double>>(text, format, solver);
+      break;
+    case 5:
+      exercise<bireg::SL3<double>>(text, format, solver);
+      break;
+    case 6:
+      exercise<bireg::GLp<3, double>>(text, format, solver);
+      break;
+    default:
+      exercise<bireg::Heisenberg<double>>(text, format, solver);
       break;
   }
   return 0;
