@@ -97,16 +97,28 @@ Eigen::Matrix<long double, D, D> reference_psi(const Eigen::Matrix<long double, 
   bireg::Sim3<double>, bireg::SL3<double>, (bireg::GLp<3, double>), bireg::Heisenberg<double>, \
       (bireg::Product<bireg::SO3<double>, bireg::Rn<3, double>>)
 
+// With every solver and method: the scene groups take the same options as
+// SE(3).
 TEMPLATE_TEST_CASE("scene groups: noise-free geodesics are recovered", "[scene][regression]",
                    BIREG_SCENE_GROUPS) {
   using G = TestType;
   std::mt19937 rng(501);
   const Scene<G> scene = make_scene<G>(rng);
-  const auto fit = regression<G>().fit(scene.exact, scene.t);
-  REQUIRE(fit.ok());
-  REQUIRE(distance<G>(fit.geodesic.start(), scene.g0) <= kTolerance);
-  REQUIRE(distance<G>(fit.geodesic.end(), G::compose(scene.g0, G::exp(scene.x))) <= kTolerance);
-  REQUIRE(fit.diagnostics.residual_rms <= kTolerance);
+  for (bireg::Solver solver : {bireg::Solver::paper, bireg::Solver::optimal_linear,
+                               bireg::Solver::preconditioned, bireg::Solver::gauss_newton}) {
+    for (bireg::Method method : {bireg::Method::exact, bireg::Method::series_adaptive}) {
+      typename bireg::GeodesicRegression<G>::Options options;
+      options.tolerance = 1e-13;
+      options.solver = solver;
+      options.method = method;
+      const auto fit = bireg::GeodesicRegression<G>(options).fit(scene.exact, scene.t);
+      CAPTURE(bireg::to_string(solver), bireg::to_string(method));
+      REQUIRE(fit.ok());
+      REQUIRE(distance<G>(fit.geodesic.start(), scene.g0) <= kTolerance);
+      REQUIRE(distance<G>(fit.geodesic.end(), G::compose(scene.g0, G::exp(scene.x))) <= kTolerance);
+      REQUIRE(fit.diagnostics.residual_rms <= kTolerance);
+    }
+  }
 }
 
 TEMPLATE_TEST_CASE("scene groups: the fit is left, right and inverse equivariant",

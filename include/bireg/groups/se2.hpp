@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "bireg/core/small_angle.hpp"
+#include "bireg/groups/affine.hpp"
 #include "bireg/groups/tolerance.hpp"
 
 namespace bireg {
@@ -32,15 +33,7 @@ struct SE2 {
   using Matrix2 = Eigen::Matrix<Scalar, 2, 2>;
 
   static Element identity() { return Element::Identity(); }
-  static Element compose(const Element& a, const Element& b) {
-    Element g = Element::Identity();
-    g.template topLeftCorner<2, 2>() =
-        a.template topLeftCorner<2, 2>() * b.template topLeftCorner<2, 2>();
-    g.template topRightCorner<2, 1>() =
-        a.template topLeftCorner<2, 2>() * b.template topRightCorner<2, 1>() +
-        a.template topRightCorner<2, 1>();
-    return g;
-  }
+  static Element compose(const Element& a, const Element& b) { return affine::compose(a, b); }
   static Element inverse(const Element& g) {
     Element inv = Element::Identity();
     const Matrix2 rt = g.template topLeftCorner<2, 2>().transpose();

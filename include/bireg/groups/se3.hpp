@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "bireg/core/small_angle.hpp"
+#include "bireg/groups/affine.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
 
@@ -37,15 +38,7 @@ struct SE3 {
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
 
   static Element identity() { return Element::Identity(); }
-  static Element compose(const Element& a, const Element& b) {
-    Element g = Element::Identity();
-    g.template topLeftCorner<3, 3>() =
-        a.template topLeftCorner<3, 3>() * b.template topLeftCorner<3, 3>();
-    g.template topRightCorner<3, 1>() =
-        a.template topLeftCorner<3, 3>() * b.template topRightCorner<3, 1>() +
-        a.template topRightCorner<3, 1>();
-    return g;
-  }
+  static Element compose(const Element& a, const Element& b) { return affine::compose(a, b); }
   static Element inverse(const Element& g) {
     Element inv = Element::Identity();
     const Matrix3 rt = g.template topLeftCorner<3, 3>().transpose();

@@ -32,6 +32,7 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "bireg/core/small_angle.hpp"
+#include "bireg/groups/affine.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
 
@@ -149,15 +150,7 @@ struct Sim3 {
   using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
 
   static Element identity() { return Element::Identity(); }
-  static Element compose(const Element& a, const Element& b) {
-    Element g = Element::Identity();
-    g.template topLeftCorner<3, 3>() =
-        a.template topLeftCorner<3, 3>() * b.template topLeftCorner<3, 3>();
-    g.template topRightCorner<3, 1>() =
-        a.template topLeftCorner<3, 3>() * b.template topRightCorner<3, 1>() +
-        a.template topRightCorner<3, 1>();
-    return g;
-  }
+  static Element compose(const Element& a, const Element& b) { return affine::compose(a, b); }
   // (s R)^{-1} = R^T / s = (s R)^T / s^2.
   static Element inverse(const Element& g) {
     const Matrix3 scaled_rotation = g.template topLeftCorner<3, 3>();
