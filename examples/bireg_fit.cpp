@@ -1,8 +1,8 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
 //   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum]
-//             [--method exact|series|series_adaptive] [--order M] [--solver
-//             paper|optimal_linear|preconditioned|gauss_newton]
+//             [--method exact|series|series_adaptive] [--order M]
+//             [--solver paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--output-trajectory FILE] FILE|-
 //

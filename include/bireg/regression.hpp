@@ -770,12 +770,12 @@ class GeodesicRegression {
   // allocation happens inside the loop (the history is reserved). Returns the state at the returned
   // endpoints; result.residuals hold the residuals there (unless the series did not converge at
   // that state).
-  template <class Observations>
   //
   // Every state it returns has a convergent series and a finite force, hence
   // finite residuals, except when even the fallback start (the middle
   // observation as a constant model, whose residuals the chart fit checked)
   // is unusable, which cannot happen: there X = 0.
+  template <class Observations>
   State iterate(const Observations& observations, const Problem& problem, const Element& start0,
                 const Element& start1, const Element& fallback, Result& result) const {
     using std::isfinite;
@@ -823,6 +823,14 @@ class GeodesicRegression {
         result.status = Status::diverged;
         return state;
       }
+      result.step_norms.push_back(step_norm);
+      result.iterations = iteration + 1;
+      // The step proposed at the current endpoints certifies them: it is
+      // what remains to be moved, so it is not taken when below tolerance.
+      if (step_norm <= options_.tolerance) {
+        result.status = Status::converged;
+        return state;
+      }
       // Steps below sqrt(epsilon) relative to the geodesic's size are at
       // the rounding level, where they fluctuate without meaning.
       const Scalar rounding_level =
@@ -834,14 +842,6 @@ class GeodesicRegression {
       } else if (options_.tolerance > 0 && step_norm <= rounding_level &&
                  ++iterations_without_progress >= kStallIterations) {
         result.status = Status::stalled;
-        return state;
-      }
-      result.step_norms.push_back(step_norm);
-      result.iterations = iteration + 1;
-      // The step proposed at the current endpoints certifies them: it is
-      // what remains to be moved, so it is not taken when below tolerance.
-      if (step_norm <= options_.tolerance) {
-        result.status = Status::converged;
         return state;
       }
 
