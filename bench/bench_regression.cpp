@@ -154,7 +154,7 @@ std::pair<typename GL::Element, typename GL::Element> reference_fit(const Proble
   typename bireg::GeodesicRegression<GL>::Options options;
   options.tolerance = 1e-15L;
   const auto result = bireg::GeodesicRegression<GL>(options).fit(f, t);
-  return {result.geodesic.start(), result.geodesic.end()};
+  return {result.geodesic->start(), result.geodesic->end()};
 }
 
 template <class Element, class Reference>
@@ -189,7 +189,7 @@ void register_tradeoff(const char* group, double length, bireg::Method method, i
     for (auto _ : state) {
       const auto result = regression.fit(problem.f, problem.t);
       benchmark::DoNotOptimize(result.geodesic);
-      error = endpoint_error(result.geodesic.start(), result.geodesic.end(), reference);
+      error = endpoint_error(result.geodesic->start(), result.geodesic->end(), reference);
       iterations = result.iterations;
     }
     state.counters["endpoint_error"] = error;
@@ -215,7 +215,7 @@ void BM_Precision(benchmark::State& state) {
   for (auto _ : state) {
     const auto result = regression.fit(f, t);
     benchmark::DoNotOptimize(result.geodesic);
-    error = endpoint_error(result.geodesic.start(), result.geodesic.end(), reference);
+    error = endpoint_error(result.geodesic->start(), result.geodesic->end(), reference);
     iterations = result.iterations;
   }
   state.counters["endpoint_error"] = error;

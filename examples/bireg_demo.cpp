@@ -148,7 +148,7 @@ bool fit_file(const std::string& path, bireg::tools::Format format, Fitted<G>& o
 // Coordinates of log(g0^{-1} f_i), and of the fitted line, for the picture.
 template <class G>
 std::vector<Panel> chart_panels(const Fitted<G>& fitted, int first, int count, Panel panel) {
-  const auto& geodesic = fitted.result.geodesic;
+  const auto& geodesic = *fitted.result.geodesic;
   for (int k = first; k < first + count; ++k) {
     std::vector<double> series;
     for (const auto& f : fitted.data.observations)
@@ -187,8 +187,8 @@ int main(int argc, char** argv) {
   if (!fit_file(data_dir + "/so3_xio_imu_window.csv", bireg::tools::Format::matrix, imu)) return 1;
   {
     const auto& r = imu.result;
-    const double seconds = r.geodesic.t_max() - r.geodesic.t_min();
-    const Rotation::Tangent w = r.geodesic.body_velocity();
+    const double seconds = r.geodesic->t_max() - r.geodesic->t_min();
+    const Rotation::Tangent w = r.geodesic->body_velocity();
     std::printf("x-IMU orientation (SO3, %zu samples over %.2f s)\n", imu.data.observations.size(),
                 seconds);
     std::printf("  fitted angular velocity    %.1f deg/s about body axis (%.3f, %.3f, %.3f)\n",
@@ -209,8 +209,8 @@ int main(int argc, char** argv) {
   if (!fit_file(data_dir + "/se3_deepmimic_walk.tum", bireg::tools::Format::tum, walk)) return 1;
   {
     const auto& r = walk.result;
-    const double seconds = r.geodesic.t_max() - r.geodesic.t_min();
-    const Pose::Tangent v = r.geodesic.body_velocity();
+    const double seconds = r.geodesic->t_max() - r.geodesic->t_min();
+    const Pose::Tangent v = r.geodesic->body_velocity();
     double rotation_sq = 0, translation_sq = 0;
     for (const auto& residual : r.residuals) {
       translation_sq += residual.head<3>().squaredNorm();

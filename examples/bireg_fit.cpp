@@ -206,9 +206,9 @@ int run(const Command& command) {
       "\"force_norm\": %s, "
       "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
       G::name, trajectory.observations.size(),
-      bireg::tools::json_matrix(result.geodesic.start()).c_str(),
-      bireg::tools::json_matrix(result.geodesic.end()).c_str(),
-      json_number(result.geodesic.t_min()).c_str(), json_number(result.geodesic.t_max()).c_str(),
+      bireg::tools::json_matrix(result.geodesic->start()).c_str(),
+      bireg::tools::json_matrix(result.geodesic->end()).c_str(),
+      json_number(result.geodesic->t_min()).c_str(), json_number(result.geodesic->t_max()).c_str(),
       bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
       json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
       json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(),
@@ -220,7 +220,7 @@ int run(const Command& command) {
     std::ofstream out(command.output_trajectory);
     if (!out) return fail(command.output_trajectory + ": cannot write file");
     for (double t : trajectory.covariates) {
-      out << bireg::tools::format_observation<G>(command.format, t, result.geodesic(t)) << '\n';
+      out << bireg::tools::format_observation<G>(command.format, t, (*result.geodesic)(t)) << '\n';
     }
   }
   return result.ok() ? 0 : kExitNotConverged;

@@ -40,9 +40,9 @@ int main() {
     for (int r = 0; r < 4; ++r)
       std::printf("  % .6f % .6f % .6f % .6f\n", g(r, 0), g(r, 1), g(r, 2), g(r, 3));
   };
-  print("fitted pose at t = 0 s", result.geodesic.start());
-  print("fitted pose at t = 2.97 s", result.geodesic.end());
-  const G::Tangent v = result.geodesic.body_velocity();
+  print("fitted pose at t = 0 s", result.geodesic->start());
+  print("fitted pose at t = 2.97 s", result.geodesic->end());
+  const G::Tangent v = result.geodesic->body_velocity();
   std::printf("body velocity  (% .4f % .4f % .4f | % .4f % .4f % .4f) per s\n", v[0], v[1], v[2],
               v[3], v[4], v[5]);
   std::printf("true velocity  (% .4f % .4f % .4f | % .4f % .4f % .4f) per s\n", velocity[0],

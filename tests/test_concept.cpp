@@ -1,6 +1,6 @@
 // The compile-time concept check accepts the shipped groups and a minimal
 // user-written group, and tells a group that misses pieces apart.
-#include "bireg/core/concept.hpp"
+#include "bireg/concept.hpp"
 #include "bireg/groups/se3.hpp"
 #include "catch.hpp"
 

@@ -138,11 +138,11 @@ void check_against_library(const std::string& file, bireg::tools::Format format,
       bireg::GeodesicRegression<G>().fit(trajectory.observations, trajectory.covariates);
   REQUIRE(result.ok());
   REQUIRE(bireg_test::relative_error(element_of<G>(json_numbers(run.out, "g0")),
-                                     result.geodesic.start()) <= 1e-12);
+                                     result.geodesic->start()) <= 1e-12);
   REQUIRE(bireg_test::relative_error(element_of<G>(json_numbers(run.out, "g1")),
-                                     result.geodesic.end()) <= 1e-12);
-  REQUIRE(json_numbers(run.out, "t_min").at(0) == result.geodesic.t_min());
-  REQUIRE(json_numbers(run.out, "t_max").at(0) == result.geodesic.t_max());
+                                     result.geodesic->end()) <= 1e-12);
+  REQUIRE(json_numbers(run.out, "t_min").at(0) == result.geodesic->t_min());
+  REQUIRE(json_numbers(run.out, "t_max").at(0) == result.geodesic->t_max());
   REQUIRE(json_numbers(run.out, "iterations").at(0) == result.iterations);
   REQUIRE(std::abs(json_numbers(run.out, "residual_rms").at(0) - result.diagnostics.residual_rms) <=
           1e-12 * result.diagnostics.residual_rms);

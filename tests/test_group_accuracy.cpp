@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "bireg/core/small_angle.hpp"
+#include "bireg/math/small_angle.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"

@@ -1,4 +1,4 @@
-// The series inverse differentials (paper, Lemma "diff_2_gam" and Corollary
+// The series inverse differentials (paper, Lemma 3.1 and Corollary
 // "diff_1_gam", in DESIGN.md's weighted form psi_s) against finite
 // differences of the geodesic's endpoint derivatives.
 //
@@ -10,11 +10,11 @@
 #include <cmath>
 #include <random>
 
-#include "bireg/core/inverse_differential.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/math/psi_series.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
@@ -138,11 +138,21 @@ TEST_CASE("the series converges at the rate the spectral radius predicts", "[ser
 
 TEST_CASE("psi is regular at s = 0 and s = 1", "[series]") {
   using G = bireg::SO3<double>;
-  const G::AdMatrix a = G::ad(G::Tangent(0.4, -2.0, 1.0));
+  const G::Tangent x(0.4, -2.0, 1.0);
+  const G::AdMatrix a = G::ad(x);
   const G::Tangent r(1.0, 2.0, 3.0);
-  // psi_0 = 0 and psi_1 = 1 identically: every coefficient beyond the first
-  // cancels exactly in the table (a sum of b_k / (m - k + 1)! that vanishes),
-  // up to the rounding of its long double entries.
-  REQUIRE(bireg::apply_psi_series<double, 3>(a, 0.0, r, 40).isZero(0));
+  // psi_1 = 1 identically: every coefficient beyond the first cancels
+  // exactly in the table (a sum of b_k / (m - k + 1)! that vanishes), up to
+  // the rounding of its long double entries.
   REQUIRE((bireg::apply_psi_series<double, 3>(a, 1.0, r, 40) - r).norm() <= 1e-15 * r.norm());
+  // At s -> 0, psi_s(z) = s^2 (1 - e^{-z})/(1 - e^{-sz}) = s J_r(z) (1 + O(s z)):
+  // the series divided by s tends to the right Jacobian (SO3's closed form,
+  // no series), with an error of first order in s |x| (2.3e-8 at s = 1e-8).
+  for (double s : {1e-8, 1e-4}) {
+    const G::Tangent limit = G::right_jacobian(x) * r;
+    const G::Tangent scaled = bireg::apply_psi_series<double, 3>(a, s, r, 40) / s;
+    CAPTURE(s);
+    REQUIRE((scaled - limit).norm() <= 2 * s * x.norm() * limit.norm() + 1e-14);
+    REQUIRE((scaled - limit).norm() >= 1e-3 * s * limit.norm());  // the O(s) term is there
+  }
 }

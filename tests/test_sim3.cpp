@@ -27,7 +27,7 @@
 #include <utility>
 #include <vector>
 
-#include "bireg/core/concept.hpp"
+#include "bireg/concept.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"

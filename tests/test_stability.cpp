@@ -69,14 +69,13 @@ typename bireg::GeodesicRegression<G>::Result fit(
     const Case<G>& c, bireg::Solver solver = bireg::Solver::gauss_newton) {
   typename bireg::GeodesicRegression<G>::Options options;
   options.solver = solver;
-  options.weights = c.w;
-  return bireg::GeodesicRegression<G>(options).fit(c.f, c.t);
+  return bireg::GeodesicRegression<G>(options).fit(c.f, c.t, c.w);
 }
 
 template <class G>
 bool finite(const typename bireg::GeodesicRegression<G>::Result& r) {
   const auto& d = r.diagnostics;
-  bool ok = r.geodesic.start().allFinite() && r.geodesic.end().allFinite();
+  bool ok = r.geodesic->start().allFinite() && r.geodesic->end().allFinite();
   for (double v :
        {double(d.mu_min), double(d.mu_max), double(d.condition_number), double(d.force_norm),
         double(d.residual_rms), double(d.explained_variance), double(d.contraction_factor)}) {
@@ -90,7 +89,7 @@ bool finite(const typename bireg::GeodesicRegression<G>::Result& r) {
 // Absolute error of the fitted displacement X = log(g0^{-1} g1).
 template <class G>
 double slope_error(const Case<G>& c, const typename bireg::GeodesicRegression<G>::Result& r) {
-  return (r.geodesic.displacement().template cast<double>() - c.x).norm();
+  return (r.geodesic->displacement().template cast<double>() - c.x).norm();
 }
 
 template <class G>
@@ -131,7 +130,7 @@ TEMPLATE_TEST_CASE("tiny geodesics keep the slope to the data's rounding", "[sta
 // recovered to rounding (the principal log is well conditioned up to pi;
 // 1e-12 leaves three orders over the measured 1e-15). Beyond pi the
 // Cartan-Schouten geodesic between the endpoints takes the short way round
-// and cannot pass through the data: Gauss-Newton stops with `stalled`, the
+// and cannot pass through the data: Gauss-Newton stops with `no_descent`, the
 // paper's step with `max_iterations`; the endpoints stay finite.
 TEMPLATE_TEST_CASE("geodesics up to pi are recovered, beyond pi the fit says so", "[stability]",
                    bireg::SO3<double>, bireg::SE3<double>) {
@@ -150,7 +149,7 @@ TEMPLATE_TEST_CASE("geodesics up to pi are recovered, beyond pi the fit says so"
                     G::name, length, bireg::to_string(r.status), r.iterations,
                     slope_error(c, r) / length);
     } else {
-      REQUIRE(r.status == bireg::Status::stalled);
+      REQUIRE(r.status == bireg::Status::no_descent);
       const auto paper = fit(c, bireg::Solver::paper);
       REQUIRE(paper.status == bireg::Status::max_iterations);
       REQUIRE(finite<G>(paper));
@@ -220,7 +219,7 @@ TEMPLATE_TEST_CASE("two observations are interpolated", "[stability]", bireg::SE
   REQUIRE(r.ok());
   const double tolerance = 64 * eps<G>();  // a handful of compositions of O(1) matrices
   for (int i = 0; i < 2; ++i) {
-    const auto difference = (r.geodesic(c.t[i]) - c.f[i]).cwiseAbs().maxCoeff();
+    const auto difference = ((*r.geodesic)(c.t[i]) - c.f[i]).cwiseAbs().maxCoeff();
     REQUIRE(difference <= tolerance);
   }
   char line[160];
@@ -274,7 +273,7 @@ TEMPLATE_TEST_CASE("SE3 with metres of 1e6 next to rotations of 1e-6 rad", "[sta
   options.tolerance = std::is_same_v<S, float> ? S(1e-1) : S(1e-6);  // steps are in metres here
   const auto r = bireg::GeodesicRegression<G>(options).fit(f, t);
   REQUIRE(r.ok());
-  const Eigen::Matrix<double, 6, 1> fitted = r.geodesic.displacement().template cast<double>();
+  const Eigen::Matrix<double, 6, 1> fitted = r.geodesic->displacement().template cast<double>();
   const double translation = (fitted.head<3>() - x.head<3>()).norm() / x.head<3>().norm();
   const double rotation = (fitted.tail<3>() - x.tail<3>()).norm() / x.tail<3>().norm();
   const double bound = std::is_same_v<S, float> ? 1e-3 : 1e-10;
@@ -353,15 +352,22 @@ TEMPLATE_TEST_CASE("float keeps float-scaled accuracy", "[stability][float]", bi
 }
 
 // One observation rotated by pi/2: the estimator is not robust (it is a
-// least-squares-type estimator), but it is still computed: converged.
+// least-squares-type estimator), but it is still computed: converged. The
+// clean fit's slope is off by the noise (0.01 per coordinate over 30
+// points: ~0.01 rad); the outlier moves it by ~0.09 rad (a weight 1/30 on a
+// pi/2 residual, amplified by the slope's leverage), far beyond that.
 TEST_CASE("an outlier moves the fit but the fit converges", "[stability]") {
   using G = bireg::SO3<double>;
   Case<G> c = make_case<G>(0.6, 0.01, 30, 9);
+  const double clean_error = slope_error(c, fit(c));
+  REQUIRE(clean_error <= 0.02);
   c.f[10] = G::compose(c.f[10], G::exp(G::Tangent(1.5707963267948966, 0, 0)));
   for (bireg::Solver solver : {bireg::Solver::paper, bireg::Solver::gauss_newton}) {
     const auto r = fit(c, solver);
     REQUIRE(r.ok());
     REQUIRE(finite<G>(r));
+    REQUIRE(slope_error(c, r) >= 0.05);
+    REQUIRE(slope_error(c, r) >= 3 * clean_error);
     char line[160];
     std::snprintf(
         line, sizeof line, "| SO3 outlier (pi/2) | %s | %s, %d it | slope error %.3f rad |",

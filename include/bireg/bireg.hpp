@@ -1,12 +1,8 @@
-// bireg: everything at once. Include single headers instead to compile only
-// what you use (each is self-contained).
+// bireg: everything at once (the groups, the concept, geodesics and the
+// regression). Including only what you use compiles faster.
 #pragma once
 
-#include "bireg/core/bernoulli.hpp"
-#include "bireg/core/concept.hpp"
-#include "bireg/core/exact_inverse_differential.hpp"
-#include "bireg/core/inverse_differential.hpp"
-#include "bireg/core/small_angle.hpp"
+#include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/product.hpp"

@@ -9,7 +9,7 @@
 // the whole curve, which is what makes the regression bi-invariant.
 #pragma once
 
-#include "bireg/core/concept.hpp"
+#include "bireg/concept.hpp"
 
 namespace bireg {
 

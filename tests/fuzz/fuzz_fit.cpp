@@ -56,7 +56,7 @@ void exercise(const std::string& text, bireg::tools::Format format, bireg::Solve
     require(!result.message.empty());
     return;
   }
-  require(result.geodesic.start().allFinite() && result.geodesic.end().allFinite());
+  require(result.geodesic->start().allFinite() && result.geodesic->end().allFinite());
   const auto& d = result.diagnostics;
   for (double x : {d.mu_min, d.mu_max, d.step_size, d.contraction_factor, d.force_norm,
                    d.residual_rms, d.residual_rms_about_mean, d.explained_variance}) {

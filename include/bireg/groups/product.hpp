@@ -16,7 +16,7 @@
 
 #include <Eigen/Core>
 
-#include "bireg/core/inverse_differential.hpp"
+#include "bireg/groups/capabilities.hpp"
 
 namespace bireg {
 
@@ -82,6 +82,13 @@ struct Product<G1, G2> {
   static AdMatrix Ad(const Element& g) { return block_diagonal(G1::Ad(g.first), G2::Ad(g.second)); }
   static Scalar ad_spectral_radius(const Tangent& x) {
     return std::max(bireg::ad_spectral_radius<G1>(head(x)), bireg::ad_spectral_radius<G2>(tail(x)));
+  }
+  static AdMatrix right_jacobian(const Tangent& x) {
+    return block_diagonal(bireg::right_jacobian<G1>(head(x)), bireg::right_jacobian<G2>(tail(x)));
+  }
+  static AdMatrix right_jacobian_inverse(const Tangent& x) {
+    return block_diagonal(bireg::right_jacobian_inverse<G1>(head(x)),
+                          bireg::right_jacobian_inverse<G2>(tail(x)));
   }
   static bool is_element(const Element& g, Scalar tol) {
     return G1::is_element(g.first, tol) && G2::is_element(g.second, tol);

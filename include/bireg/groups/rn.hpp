@@ -42,4 +42,9 @@ struct Rn {
   static bool is_element(const Element& g, Scalar /*tol*/ = Scalar(0)) { return g.allFinite(); }
 };
 
+template <int N>
+using Rnd = Rn<N, double>;
+template <int N>
+using Rnf = Rn<N, float>;
+
 }  // namespace bireg

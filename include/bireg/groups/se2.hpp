@@ -13,13 +13,14 @@
 
 #include <Eigen/Core>
 
-#include "bireg/core/small_angle.hpp"
 #include "bireg/groups/affine.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/psi_closed_form.hpp"
+#include "bireg/math/small_angle.hpp"
 
 namespace bireg {
 
-template <class Scalar_>
+template <class Scalar_ = double>
 struct SE2 {
   using Scalar = Scalar_;
   static constexpr int dof = 3;
@@ -119,6 +120,47 @@ struct SE2 {
         (g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 3>(0, 0, 1)).cwiseAbs().maxCoeff();
     return orthonormality <= tol && abs(r.determinant() - Scalar(1)) <= tol && last_row <= tol;
   }
+  // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
+  // "Exact form"): the rotation part as on SO(2) rotated by F(i theta), the
+  // angle's column mapped by f1 I + theta f2 J. Angle at least kExactMinAngle.
+  struct ClosedFormPsi {
+    using SinCos = psi_closed_form::SinCos<Scalar>;
+    struct Prepared {
+      Tangent x;
+      Scalar theta;  // |theta|; the sign is carried by x[2]
+      SinCos half;
+    };
+    static Scalar angle(const Tangent& x) {
+      using std::abs;
+      return abs(x[2]);
+    }
+    static Prepared prepare(const Tangent& x) {
+      using std::abs;
+      return {x, abs(x[2]), SinCos::of(abs(x[2]) / 2)};
+    }
+    static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                         const Tangent& r) {
+      if (s == 0) return Tangent::Zero();
+      // F(-i theta) = conj F(i theta): the coefficients at |theta|, the sign
+      // carried by the signed angle.
+      const auto c =
+          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
+      const Scalar theta = p.x[2];
+      const Scalar re = s - theta * theta * c.f2;  // Re F(i theta)
+      const Scalar im = theta * c.f1;              // Im F(i theta), odd in theta
+      // The angle's ad column is c = -J rho; the block maps it by f1 I + theta f2 J.
+      const Scalar cx = p.x[1], cy = -p.x[0];
+      const Scalar lx = c.f1 * cx - theta * c.f2 * cy, ly = c.f1 * cy + theta * c.f2 * cx;
+      Tangent out;
+      out[0] = re * r[0] - im * r[1] + lx * r[2];
+      out[1] = im * r[0] + re * r[1] + ly * r[2];
+      out[2] = s * r[2];
+      return out;
+    }
+  };
 };
+
+using SE2d = SE2<double>;
+using SE2f = SE2<float>;
 
 }  // namespace bireg

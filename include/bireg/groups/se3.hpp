@@ -16,14 +16,15 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
 
-#include "bireg/core/small_angle.hpp"
 #include "bireg/groups/affine.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/psi_closed_form.hpp"
+#include "bireg/math/small_angle.hpp"
 
 namespace bireg {
 
-template <class Scalar_>
+template <class Scalar_ = double>
 struct SE3 {
   using Scalar = Scalar_;
   static constexpr int dof = 6;
@@ -116,6 +117,31 @@ struct SE3 {
     return m;
   }
 
+  // Right Jacobian of exp (groups/capabilities.hpp). ad_xi = [W P; 0 W] is
+  // block triangular with equal diagonal blocks, so for any analytic F,
+  // F(ad_xi) = [F(W) L; 0 F(W)] with L the derivative of F(W) along P. For
+  // F(z) = z / (1 - e^{-z}) (J_r^{-1}), F(W) = I + W/2 + e(t) W^2 with
+  // e(t) = (1 - (t/2) cot(t/2))/t^2, t = |omega|, and t changes by
+  // (omega . rho)/t along P, so
+  //   L = P/2 + e(t) (W P + P W) + (omega . rho) (e'(t)/t) W^2.
+  // J_r itself is the block inverse [J, -J L J; 0, J], J = SO(3)'s J_r.
+  static AdMatrix right_jacobian_inverse(const Tangent& xi) {
+    AdMatrix m = AdMatrix::Zero();
+    const Matrix3 j_inverse = Rotation::right_jacobian_inverse(xi.template tail<3>());
+    m.template topLeftCorner<3, 3>() = j_inverse;
+    m.template bottomRightCorner<3, 3>() = j_inverse;
+    m.template topRightCorner<3, 3>() = coupling_of_jacobian_inverse(xi);
+    return m;
+  }
+  static AdMatrix right_jacobian(const Tangent& xi) {
+    AdMatrix m = AdMatrix::Zero();
+    const Matrix3 j = Rotation::right_jacobian(xi.template tail<3>());
+    m.template topLeftCorner<3, 3>() = j;
+    m.template bottomRightCorner<3, 3>() = j;
+    m.template topRightCorner<3, 3>() = -j * coupling_of_jacobian_inverse(xi) * j;
+    return m;
+  }
+
   // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
   // to within tol (max-norm), all finite.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {
@@ -125,6 +151,60 @@ struct SE3 {
                                 .maxCoeff();
     return last_row <= tol && Rotation::is_element(g.template topLeftCorner<3, 3>(), tol);
   }
+
+  // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
+  // "Exact form"): the diagonal blocks as on SO(3), the upper-right block the
+  // derivative of F(W) along P = hat(rho). Angle at least kExactMinAngle.
+  struct ClosedFormPsi {
+    using SinCos = psi_closed_form::SinCos<Scalar>;
+    struct Prepared {
+      Vector3 rho, omega;
+      Scalar theta, omega_dot_rho;
+      SinCos half;
+    };
+    static Scalar angle(const Tangent& x) { return x.template tail<3>().norm(); }
+    static Prepared prepare(const Tangent& x) {
+      const Vector3 rho = x.template head<3>(), omega = x.template tail<3>();
+      const Scalar theta = omega.norm();
+      return {rho, omega, theta, omega.dot(rho), SinCos::of(theta / 2)};
+    }
+    static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                         const Tangent& r) {
+      if (s == 0) return Tangent::Zero();
+      const auto c =
+          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
+      const Vector3 r_rho = r.template head<3>(), r_omega = r.template tail<3>();
+      const auto rotation_block = [&](const Vector3& v) {
+        const Vector3 w_v = p.omega.cross(v);
+        return Vector3(s * v + c.f1 * w_v + c.f2 * p.omega.cross(w_v));
+      };
+      const Vector3 w_v = p.omega.cross(r_omega);
+      const Vector3 p_v = p.rho.cross(r_omega);
+      const Vector3 derivative = c.f1 * p_v + c.f2 * (p.omega.cross(p_v) + p.rho.cross(w_v)) +
+                                 p.omega_dot_rho * (c.g1 * w_v + c.g2 * p.omega.cross(w_v));
+      Tangent out;
+      out.template head<3>() = rotation_block(r_rho) + derivative;
+      out.template tail<3>() = rotation_block(r_omega);
+      return out;
+    }
+  };
+
+ private:
+  // L, the upper-right block of J_r^{-1} (see right_jacobian_inverse).
+  static Matrix3 coupling_of_jacobian_inverse(const Tangent& xi) {
+    using std::sqrt;
+    const Vector3 rho = xi.template head<3>(), omega = xi.template tail<3>();
+    const Scalar angle = sqrt(omega.squaredNorm());
+    const Matrix3 w = Rotation::hat(omega), p = Rotation::hat(rho);
+    const Scalar e = small_angle::one_minus_half_x_cot_half_x_over_x2(angle);
+    const Scalar e_derivative_over_angle =
+        small_angle::one_minus_half_x_cot_half_x_over_x2_derivative_over_x(angle);
+    return p / Scalar(2) + e * (w * p + p * w) +
+           (omega.dot(rho) * e_derivative_over_angle) * (w * w);
+  }
 };
+
+using SE3d = SE3<double>;
+using SE3f = SE3<float>;
 
 }  // namespace bireg

@@ -31,10 +31,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
 
-#include "bireg/core/small_angle.hpp"
 #include "bireg/groups/affine.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/small_angle.hpp"
 
 namespace bireg {
 namespace sim3_detail {
@@ -135,7 +135,7 @@ Vector3 apply(const Coefficients<Scalar>& k, const Vector3& omega, const Vector3
 
 }  // namespace sim3_detail
 
-template <class Scalar_>
+template <class Scalar_ = double>
 struct Sim3 {
   using Scalar = Scalar_;
   static constexpr int dof = 7;
@@ -289,5 +289,8 @@ struct Sim3 {
     return scaled_rotation.squaredNorm() / Scalar(3);
   }
 };
+
+using Sim3d = Sim3<double>;
+using Sim3f = Sim3<float>;
 
 }  // namespace bireg

@@ -10,10 +10,11 @@
 #include <Eigen/Core>
 
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/psi_closed_form.hpp"
 
 namespace bireg {
 
-template <class Scalar_>
+template <class Scalar_ = double>
 struct SO2 {
   using Scalar = Scalar_;
   static constexpr int dof = 1;
@@ -63,6 +64,24 @@ struct SO2 {
     const Scalar orthonormality = (g.transpose() * g - Element::Identity()).cwiseAbs().maxCoeff();
     return orthonormality <= tol && abs(g.determinant() - Scalar(1)) <= tol;
   }
+  // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
+  // "Exact form"): SO(2) is commutative, ad = 0, so psi_s(0) = s.
+  struct ClosedFormPsi {
+    using SinCos = psi_closed_form::SinCos<Scalar>;
+    struct Prepared {
+      Scalar theta = 0;
+      SinCos half{0, 1};
+    };
+    static Scalar angle(const Tangent&) { return Scalar(kExactMinAngle); }  // ad = 0: always exact
+    static Prepared prepare(const Tangent&) { return {}; }
+    static Tangent apply(const Prepared&, Scalar s, const SinCos&, const SinCos&,
+                         const Tangent& r) {
+      return s * r;
+    }
+  };
 };
+
+using SO2d = SO2<double>;
+using SO2f = SO2<float>;
 
 }  // namespace bireg

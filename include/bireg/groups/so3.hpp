@@ -15,13 +15,15 @@
 #include <cmath>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross()
 
-#include "bireg/core/small_angle.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/psi_closed_form.hpp"
+#include "bireg/math/small_angle.hpp"
 
 namespace bireg {
 
-template <class Scalar_>
+template <class Scalar_ = double>
 struct SO3 {
   using Scalar = Scalar_;
   static constexpr int dof = 3;
@@ -31,7 +33,7 @@ struct SO3 {
   using Tangent = Eigen::Matrix<Scalar, 3, 1>;
   using AdMatrix = Eigen::Matrix<Scalar, 3, 3>;
   using Algebra = Eigen::Matrix<Scalar, 3, 3>;
-  using Quaternion = Eigen::Matrix<Scalar, 4, 1>;  // (w, x, y, z)
+  using Quaternion = Eigen::Quaternion<Scalar>;
 
   static Element identity() { return Element::Identity(); }
   static Element compose(const Element& a, const Element& b) { return a * b; }
@@ -51,33 +53,46 @@ struct SO3 {
     return Element::Identity() + sin_over_angle * w + one_minus_cos_over_angle2 * (w * w);
   }
 
-  // Unit quaternion (w >= 0) of a rotation matrix by Shepperd's method. For a
-  // matrix slightly off SO(3) the result is not exactly unit; log() only
-  // uses ratios of its components, so that does not matter there.
+  // Unit quaternion (w >= 0) of a rotation matrix by Shepperd's method: the
+  // largest of |w|, |x|, |y|, |z| is computed from the diagonal, the other
+  // three from sums or differences of off-diagonal pairs (4 q_a q_b is
+  // linear in r for every pair), so no component is formed by cancellation.
+  // For a matrix slightly off SO(3) the result is not exactly unit; log()
+  // only uses ratios of its components, so that does not matter there.
   static Quaternion to_quaternion(const Element& r) {
     using std::sqrt;
     const Scalar trace = r(0, 0) + r(1, 1) + r(2, 2);
-    Quaternion q;  // 4 q_a q_b are linear in r for every pair (a, b)
+    Scalar w, x, y, z;
     if (trace >= r(0, 0) && trace >= r(1, 1) && trace >= r(2, 2)) {
       const Scalar four_w = Scalar(2) * sqrt(Scalar(1) + trace);
-      q << four_w / Scalar(4), (r(2, 1) - r(1, 2)) / four_w, (r(0, 2) - r(2, 0)) / four_w,
-          (r(1, 0) - r(0, 1)) / four_w;
+      w = four_w / Scalar(4);
+      x = (r(2, 1) - r(1, 2)) / four_w;
+      y = (r(0, 2) - r(2, 0)) / four_w;
+      z = (r(1, 0) - r(0, 1)) / four_w;
     } else if (r(0, 0) >= r(1, 1) && r(0, 0) >= r(2, 2)) {
       const Scalar four_x = Scalar(2) * sqrt(Scalar(1) + r(0, 0) - r(1, 1) - r(2, 2));
-      q << (r(2, 1) - r(1, 2)) / four_x, four_x / Scalar(4), (r(0, 1) + r(1, 0)) / four_x,
-          (r(0, 2) + r(2, 0)) / four_x;
+      w = (r(2, 1) - r(1, 2)) / four_x;
+      x = four_x / Scalar(4);
+      y = (r(0, 1) + r(1, 0)) / four_x;
+      z = (r(0, 2) + r(2, 0)) / four_x;
     } else if (r(1, 1) >= r(2, 2)) {
       const Scalar four_y = Scalar(2) * sqrt(Scalar(1) - r(0, 0) + r(1, 1) - r(2, 2));
-      q << (r(0, 2) - r(2, 0)) / four_y, (r(0, 1) + r(1, 0)) / four_y, four_y / Scalar(4),
-          (r(1, 2) + r(2, 1)) / four_y;
+      w = (r(0, 2) - r(2, 0)) / four_y;
+      x = (r(0, 1) + r(1, 0)) / four_y;
+      y = four_y / Scalar(4);
+      z = (r(1, 2) + r(2, 1)) / four_y;
     } else {
       const Scalar four_z = Scalar(2) * sqrt(Scalar(1) - r(0, 0) - r(1, 1) + r(2, 2));
-      q << (r(1, 0) - r(0, 1)) / four_z, (r(0, 2) + r(2, 0)) / four_z, (r(1, 2) + r(2, 1)) / four_z,
-          four_z / Scalar(4);
+      w = (r(1, 0) - r(0, 1)) / four_z;
+      x = (r(0, 2) + r(2, 0)) / four_z;
+      y = (r(1, 2) + r(2, 1)) / four_z;
+      z = four_z / Scalar(4);
     }
-    if (q[0] < Scalar(0)) q = -q;
-    return q;
+    return w < Scalar(0) ? Quaternion(-w, -x, -y, -z) : Quaternion(w, x, y, z);
   }
+
+  // The rotation of a quaternion, normalised first (q must not be zero).
+  static Element from_quaternion(const Quaternion& q) { return q.normalized().toRotationMatrix(); }
 
   // Principal logarithm: |omega| in [0, pi]. At exactly pi both +-omega are
   // logarithms; the one with the sign of the chosen quaternion is returned.
@@ -88,8 +103,8 @@ struct SO3 {
     using std::atan2;
     using std::sqrt;
     const Quaternion q = to_quaternion(r);
-    const Scalar w = q[0];
-    const Tangent v = q.template tail<3>();
+    const Scalar w = q.w();
+    const Tangent v = q.vec();
     const Scalar v_norm2 = v.squaredNorm();
     if (w * w > v_norm2) {
       const Scalar y = sqrt(v_norm2) / w;
@@ -117,6 +132,25 @@ struct SO3 {
     return sqrt(omega.squaredNorm());
   }
 
+  // Right Jacobian of exp (groups/capabilities.hpp):
+  //   J_r(omega)      = I - ((1 - cos t)/t^2) W + ((t - sin t)/t^3) W^2,
+  //   J_r(omega)^{-1} = I + W/2 + ((1 - (t/2) cot(t/2))/t^2) W^2,
+  // W = hat(omega), t = |omega|; the inverse exists for t < 2 pi.
+  static AdMatrix right_jacobian(const Tangent& omega) {
+    using std::sqrt;
+    const Scalar angle = sqrt(omega.squaredNorm());
+    const Algebra w = hat(omega);
+    return AdMatrix::Identity() - small_angle::one_minus_cos_over_x2(angle) * w +
+           small_angle::x_minus_sin_over_x3(angle) * (w * w);
+  }
+  static AdMatrix right_jacobian_inverse(const Tangent& omega) {
+    using std::sqrt;
+    const Scalar angle = sqrt(omega.squaredNorm());
+    const Algebra w = hat(omega);
+    return AdMatrix::Identity() + w / Scalar(2) +
+           small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * (w * w);
+  }
+
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.
   static bool is_element(const Element& r, Scalar tol = default_element_tolerance<Scalar>()) {
     using std::abs;
@@ -124,6 +158,33 @@ struct SO3 {
     const Scalar orthonormality = (r.transpose() * r - Element::Identity()).cwiseAbs().maxCoeff();
     return orthonormality <= tol && abs(r.determinant() - Scalar(1)) <= tol;
   }
+  // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
+  // "Exact form"): F(W) v = s v + f1 W v + f2 W^2 v, W = hat(omega). apply()
+  // needs the angle at least kExactMinAngle; the regression uses the series below.
+  struct ClosedFormPsi {
+    using SinCos = psi_closed_form::SinCos<Scalar>;
+    struct Prepared {
+      Tangent omega;
+      Scalar theta;
+      SinCos half;
+    };
+    static Scalar angle(const Tangent& x) { return x.norm(); }
+    static Prepared prepare(const Tangent& x) {
+      const Scalar theta = x.norm();
+      return {x, theta, SinCos::of(theta / 2)};
+    }
+    static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
+                         const Tangent& r) {
+      if (s == 0) return Tangent::Zero();
+      const auto c =
+          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
+      const Tangent w_r = p.omega.cross(r);
+      return s * r + c.f1 * w_r + c.f2 * p.omega.cross(w_r);
+    }
+  };
 };
+
+using SO3d = SO3<double>;
+using SO3f = SO3<float>;
 
 }  // namespace bireg

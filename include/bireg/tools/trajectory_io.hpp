@@ -183,8 +183,8 @@ std::string format_observation(Format format, double t, const typename G::Elemen
   } else {
     return line;  // read_trajectory refuses tum for other groups
   }
-  const Eigen::Vector4d q = SO3<double>::to_quaternion(rotation);  // (w, x, y, z)
-  for (double x : {translation[0], translation[1], translation[2], q[1], q[2], q[3], q[0]}) {
+  const Eigen::Quaterniond q = SO3<double>::to_quaternion(rotation);
+  for (double x : {translation[0], translation[1], translation[2], q.x(), q.y(), q.z(), q.w()}) {
     line += " " + format_double(x);
   }
   return line;

@@ -2,14 +2,18 @@
 //
 // A group is a stateless traits type G with
 //
-//   types      G::Scalar, G::Element, G::Tangent (Eigen vector of size dof),
-//              G::AdMatrix (dof x dof), G::Algebra (what hat returns)
+//   types      G::Scalar, G::Element (with allFinite(), as every Eigen matrix
+//              has), G::Tangent (Eigen vector of size dof), G::AdMatrix (dof x dof)
 //   constants  G::dof (int), G::name (const char*)
 //   functions  static G::identity(), compose(a, b), inverse(g), exp(x), log(g),
-//              hat(x), vee(X), ad(x), Ad(g), is_element(g, tol)
+//              ad(x), Ad(g), is_element(g, tol)
 //
-// with the left-trivialised conventions of DESIGN.md: ad(x) y = vee([hat x,
-// hat y]), Ad(g) x = vee(g hat(x) g^{-1}), log the principal logarithm.
+// with the left-trivialised conventions of DESIGN.md: ad(x) y = [x, y],
+// Ad(g) x = g x g^{-1} in coordinates, log the principal logarithm. That is
+// all the algorithms call. The groups shipped with bireg also have hat/vee
+// (coordinates to algebra matrices and back) for their users; optional
+// capabilities with generic fallbacks (closed-form psi, Jacobians, spectral
+// radius of ad) are in groups/capabilities.hpp, included here.
 // Every bireg algorithm starts with `static_assert(is_lie_group_v<G>)` through
 // check_lie_group<G>(), so a user-written group that misses a piece fails to
 // compile with a message that names the piece, not with a template backtrace.
@@ -20,15 +24,16 @@
 
 #include <Eigen/Core>
 
+#include "bireg/groups/capabilities.hpp"
+
 namespace bireg {
 namespace concept_detail {
 
 template <class G, class = void>
 struct has_types : std::false_type {};
 template <class G>
-struct has_types<
-    G, std::void_t<typename G::Scalar, typename G::Element, typename G::Tangent,
-                   typename G::AdMatrix, typename G::Algebra, decltype(G::dof), decltype(G::name)>>
+struct has_types<G, std::void_t<typename G::Scalar, typename G::Element, typename G::Tangent,
+                                typename G::AdMatrix, decltype(G::dof), decltype(G::name)>>
     : std::true_type {};
 
 // Each check is only instantiated when has_types holds, so a missing type
@@ -70,15 +75,12 @@ struct has_exp_log<G, std::void_t<decltype(G::exp(std::declval<const typename G:
                               typename G::Tangent>> {};
 
 template <class G, class = void>
-struct has_hat_vee : std::false_type {};
+struct has_finiteness_test : std::false_type {};
 template <class G>
-struct has_hat_vee<G, std::void_t<decltype(G::hat(std::declval<const typename G::Tangent&>())),
-                                  decltype(G::vee(std::declval<const typename G::Algebra&>()))>>
-    : std::conjunction<
-          std::is_convertible<decltype(G::hat(std::declval<const typename G::Tangent&>())),
-                              typename G::Algebra>,
-          std::is_convertible<decltype(G::vee(std::declval<const typename G::Algebra&>())),
-                              typename G::Tangent>> {};
+struct has_finiteness_test<
+    G, std::void_t<decltype(std::declval<const typename G::Element&>().allFinite())>>
+    : std::is_convertible<decltype(std::declval<const typename G::Element&>().allFinite()), bool> {
+};
 
 template <class G, class = void>
 struct has_adjoints : std::false_type {};
@@ -109,7 +111,7 @@ template <class G>
 struct check<G, true> {
   static constexpr bool value = shapes<G>::tangent && shapes<G>::ad_matrix &&
                                 has_group_operations<G>::value && has_exp_log<G>::value &&
-                                has_hat_vee<G>::value && has_adjoints<G>::value &&
+                                has_finiteness_test<G>::value && has_adjoints<G>::value &&
                                 has_is_element<G>::value;
 };
 
@@ -125,7 +127,7 @@ template <class G>
 constexpr bool check_lie_group() {
   using namespace concept_detail;
   static_assert(has_types<G>::value,
-                "bireg group concept: G must define Scalar, Element, Tangent, AdMatrix, Algebra, "
+                "bireg group concept: G must define Scalar, Element, Tangent, AdMatrix, "
                 "static constexpr int dof and static constexpr const char* name");
   if constexpr (has_types<G>::value) {
     static_assert(shapes<G>::tangent,
@@ -138,9 +140,9 @@ constexpr bool check_lie_group() {
     static_assert(has_exp_log<G>::value,
                   "bireg group concept: G needs static exp(Tangent) -> Element and "
                   "log(Element) -> Tangent");
-    static_assert(has_hat_vee<G>::value,
-                  "bireg group concept: G needs static hat(Tangent) -> Algebra and "
-                  "vee(Algebra) -> Tangent");
+    static_assert(has_finiteness_test<G>::value,
+                  "bireg group concept: G::Element needs allFinite() -> bool (every Eigen "
+                  "matrix has it; a composite element provides its own)");
     static_assert(has_adjoints<G>::value,
                   "bireg group concept: G needs static ad(Tangent) and Ad(Element) returning "
                   "AdMatrix");

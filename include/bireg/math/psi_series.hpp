@@ -1,5 +1,5 @@
 // bireg: the inverse differentials of a Cartan–Schouten geodesic as power
-// series in ad_X (paper, Lemma "diff_2_gam" and Corollary "diff_1_gam").
+// series in ad_X (paper, Lemma 3.1 and Corollary 3.2).
 //
 // In left-trivialised coordinates (DESIGN.md section 2), for the geodesic
 // gamma(s) = g0 exp(s X) and A = ad_X,
@@ -12,7 +12,7 @@
 //   psi_s(z) = s^2 phi_s(z) = sum_{m>=0} Ct_m(s) z^m,
 //   Ct_m(s)  = (-1)^m sum_{k=0}^{m} s^{k+1} b_k / (m - k + 1)!,   b_k = B_k / k!
 //
-// (the paper's C_m(s) times s^2, the tilde-C of Lemma "asymptot"'s proof).
+// (the paper's C_m(s) times s^2, the tilde-C of Lemma 3.5's proof).
 // psi_s is analytic for |z| < 2 pi / s with psi_s(0) = s and psi_0 = 0, so the
 // endpoints s = 0 and s = 1 are regular. The series converges when the
 // spectral radius of A is below 2 pi; its terms shrink roughly like
@@ -27,13 +27,11 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <type_traits>
 #include <utility>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 
-#include "bireg/core/bernoulli.hpp"
+#include "bireg/math/bernoulli.hpp"
 
 namespace bireg {
 
@@ -98,28 +96,6 @@ Eigen::Matrix<Scalar, D, 1> apply_psi_series(const Eigen::Matrix<Scalar, D, D>& 
   for (int m = order - 1; m >= 0; --m)
     sum = a * sum + psi_series_coefficient(m, s) * r;
   return sum;
-}
-
-// Spectral radius of ad_x. Groups whose ad spectrum is known in closed form
-// provide `static Scalar ad_spectral_radius(const Tangent&)` (for SO(3) and
-// SE(3) it is the rotation angle); any other group gets the eigenvalues of
-// the dof x dof matrix ad_x (fixed size: no heap allocation).
-template <class G, class = void>
-struct has_ad_spectral_radius : std::false_type {};
-template <class G>
-struct has_ad_spectral_radius<
-    G, std::void_t<decltype(G::ad_spectral_radius(std::declval<const typename G::Tangent&>()))>>
-    : std::true_type {};
-
-template <class G>
-typename G::Scalar ad_spectral_radius(const typename G::Tangent& x) {
-  if constexpr (has_ad_spectral_radius<G>::value) {
-    return G::ad_spectral_radius(x);
-  } else {
-    const typename G::AdMatrix a = G::ad(x);
-    Eigen::EigenSolver<typename G::AdMatrix> solver(a, /*computeEigenvectors=*/false);
-    return solver.eigenvalues().cwiseAbs().maxCoeff();
-  }
 }
 
 // The truncation order at which every further term of psi_s(A) r, for all s

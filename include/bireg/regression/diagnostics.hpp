@@ -1,0 +1,80 @@
+// bireg: what a fit reports beside its endpoints, written in one place
+// (diagnose) from the problem, the step rule, the iteration's record and
+// the returned state.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "bireg/regression/estimating_equations.hpp"
+#include "bireg/regression/iteration.hpp"
+#include "bireg/regression/problem.hpp"
+
+namespace bireg {
+
+template <class Scalar>
+struct RegressionDiagnostics {
+  Scalar mu_min = 0;  // eigenvalues of H (Lemma 3.7, unit covariate interval)
+  Scalar mu_max = 0;
+  // mu_max / mu_min: how well the covariates pin down the slope. The paper
+  // solver needs ~condition_number iterations; the slope's error grows
+  // like sqrt(condition_number) times the noise.
+  Scalar condition_number = 0;
+  Scalar step_size = 0;  // lambda used (1 for preconditioned and gauss_newton)
+  // Step halvings of the safeguard (every solver but paper): a step that
+  // would increase ||v|| is halved until it does not.
+  int backtracks = 0;
+  // Ratio of the last two step norms: the observed linear rate, which the
+  // theory bounds by 1 - lambda eta (Theorem 4.8; by max|1 - lambda mu| on
+  // commutative groups).
+  Scalar contraction_factor = 0;
+  int series_order = 0;                // at the returned endpoints (0: closed form)
+  Scalar series_truncation_bound = 0;  // relative size of the omitted terms
+  // ||(v0, v1)|| at the returned endpoints (0 when they are outside the
+  // series' disc: series_diverged).
+  Scalar force_norm = 0;
+  // sqrt(sum w_i |r_i|^2 / sum w_i), residuals about the fitted geodesic,
+  // and the data's spread about their mean, sqrt(sum w_i |y_i - ybar|^2 /
+  // sum w_i) with y_i = log(f_ref^{-1} f_i) in the chart at the middle
+  // observation (the constant model; see start.hpp).
+  Scalar residual_rms = 0;
+  Scalar residual_rms_about_mean = 0;
+  // 1 - residual_rms^2 / residual_rms_about_mean^2: the share of the data's
+  // spread that the geodesic explains. On R^n it is the ordinary R^2. Norms
+  // are Euclidean in the tangent coordinates (which mix units on SE(3));
+  // 1 when the data do not spread.
+  Scalar explained_variance = 0;
+};
+
+template <class G, class Rule>
+RegressionDiagnostics<typename G::Scalar> diagnose(
+    const Problem<typename G::Scalar>& problem, const Rule& rule, const IterationRecord<G>& record,
+    const State<G>& state, typename G::Scalar spread,
+    const std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  using std::sqrt;
+  RegressionDiagnostics<Scalar> d;
+  d.mu_min = problem.mu_min;
+  d.mu_max = problem.mu_max;
+  d.condition_number = problem.mu_max / problem.mu_min;
+  d.step_size = rule.step_size();
+  d.backtracks = record.backtracks;
+  d.series_order = state.order;
+  d.series_truncation_bound = state.truncation;
+  if (state.series_converges) d.force_norm = state.force.norm();
+  const std::size_t steps = record.step_norms.size();
+  if (steps >= 2 && record.step_norms[steps - 2] > 0) {
+    d.contraction_factor = record.step_norms[steps - 1] / record.step_norms[steps - 2];
+  }
+  Scalar residual_sum = 0;
+  for (std::size_t i = 0; i < residuals.size(); ++i) {
+    residual_sum += problem.w[i] * residuals[i].squaredNorm();
+  }
+  d.residual_rms = sqrt(residual_sum / problem.weight_sum);
+  d.residual_rms_about_mean = sqrt(spread / problem.weight_sum);
+  d.explained_variance = spread > 0 ? 1 - residual_sum / spread : Scalar(1);
+  return d;
+}
+
+}  // namespace bireg

@@ -1,0 +1,189 @@
+// bireg: the estimating equations, i.e. the net force (v0, v1) of the
+// paper's Definition 2.1 and Section 2.2 in left-trivialised coordinates
+// (DESIGN.md section 2): with X = log(g0^{-1} g1), A = ad_X, the residuals
+// r_i = log(b_i^{-1} f_i) at the predictions b_i = g0 exp(t_i X),
+//
+//   v0 = sum_i w_i psi_{1 - t_i}(-A) r_i,   v1 = sum_i w_i psi_{t_i}(A) r_i,
+//
+// psi_s the weighted inverse differential of Lemma 3.1 and Corollary 3.2,
+// evaluated by its series (math/psi_series.hpp) or in the group's closed
+// form (groups/capabilities.hpp). The bi-invariant estimator is the zero of
+// (v0, v1).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "bireg/concept.hpp"
+#include "bireg/geodesic.hpp"
+#include "bireg/math/psi_closed_form.hpp"
+#include "bireg/math/psi_series.hpp"
+#include "bireg/regression/problem.hpp"
+#include "bireg/regression/status.hpp"
+
+namespace bireg {
+
+// How psi is evaluated (from the options).
+struct PsiEvaluation {
+  Method method = Method::exact;
+  int series_order = 0;  // for Method::series; 0 = adaptive
+  int max_series_order = kMaxSeriesOrder;
+};
+
+template <class G>
+struct Force {
+  typename G::Tangent v0, v1;
+  typename G::Scalar norm() const {
+    using std::sqrt;
+    return sqrt(v0.squaredNorm() + v1.squaredNorm());
+  }
+};
+
+// Everything the iteration needs at one pair of endpoints.
+template <class G>
+struct State {
+  typename G::Element g0, g1;
+  typename G::Tangent x;   // log(g0^{-1} g1)
+  typename G::AdMatrix a;  // ad_x
+  int order = 0;           // series order used (0: closed form)
+  typename G::Scalar truncation = 0;
+  Force<G> force;
+  bool series_converges = true;  // spectral radius of ad_x below 2 pi
+
+  // Finite force inside the series' disc: a state the iteration may use.
+  bool usable() const { return series_converges && force.v0.allFinite() && force.v1.allFinite(); }
+};
+
+// r_i = log(b_i^{-1} f_i), the residual of one observation at the
+// prediction b_i = g0 exp(t_i X), with b_i^{-1} = exp(-t_i X) g0^{-1}.
+template <class G>
+typename G::Tangent residual(const typename G::Element& g0_inverse, const typename G::Tangent& x,
+                             typename G::Scalar t, const typename G::Element& f) {
+  return G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, f)));
+}
+
+namespace estimating_detail {
+
+// Moment form of the series: psi_s(z) = sum_m (-1)^m sum_k T[m][k] s^{k+1} z^m,
+// and A is the same for every observation, so
+//   v1 = sum_m (-A)^m u_m,  u_m = sum_k T[m][k] P_{k+1},  P_j = sum_i w_i t_i^j r_i,
+//   v0 = sum_m   A^m z_m,   z_m = sum_k T[m][k] Q_{k+1},  Q_j = sum_i w_i (1 - t_i)^j r_i
+// (psi_{1-t}(-A) flips the sign of z and of (-1)^m together). Each
+// observation then costs one exp, one log, two compositions and
+// 2 (M + 1) vector updates; the M matrix-vector products of Horner's rule
+// are paid once per iteration, not once per observation.
+template <class G, class Observations>
+Force<G> series_force(const Observations& observations, const Problem<typename G::Scalar>& problem,
+                      const typename G::Element& g0, const typename G::Tangent& x,
+                      const typename G::AdMatrix& a, int order,
+                      std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  std::array<Tangent, kMaxSeriesOrder + 2> p, q;  // P_j, Q_j for j = 1 .. order + 1
+  for (int j = 1; j <= order + 1; ++j) {
+    p[j].setZero();
+    q[j].setZero();
+  }
+  const typename G::Element g0_inverse = G::inverse(g0);
+  const std::size_t n = observations.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Scalar t = problem.t[i];
+    const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
+    residuals[i] = r;
+    Scalar t_power = problem.w[i];
+    Scalar one_minus_t_power = problem.w[i];
+    for (int j = 1; j <= order + 1; ++j) {
+      t_power *= t;
+      one_minus_t_power *= 1 - t;
+      p[j] += t_power * r;
+      q[j] += one_minus_t_power * r;
+    }
+  }
+  const auto series_term = [&](const std::array<Tangent, kMaxSeriesOrder + 2>& moments, int m) {
+    Tangent term = Tangent::Zero();
+    for (int k = 0; k <= m; ++k)
+      term += static_cast<Scalar>(kPsiSeriesTable[m][k]) * moments[k + 1];
+    return term;
+  };
+  Force<G> force{series_term(q, order), series_term(p, order)};
+  for (int m = order - 1; m >= 0; --m) {  // Horner's rule
+    force.v0 = a * force.v0 + series_term(q, m);
+    force.v1 = -(a * force.v1) + series_term(p, m);
+  }
+  return force;
+}
+
+// The closed form: psi_s(-A) is psi_s of ad_{-X}. Both directions use the
+// angles t theta/2 and (1 - t) theta/2 with their roles swapped: per
+// observation, the residual, two sin/cos pairs and two closed forms.
+template <class G, class Observations>
+Force<G> closed_form_force(const Observations& observations,
+                           const Problem<typename G::Scalar>& problem,
+                           const typename G::Element& g0, const typename G::Tangent& x,
+                           std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  using Psi = typename G::ClosedFormPsi;
+  using SinCos = psi_closed_form::SinCos<Scalar>;
+  const auto forward = Psi::prepare(x);
+  const auto backward = Psi::prepare(-x);
+  const typename G::Element g0_inverse = G::inverse(g0);
+  Force<G> force{Tangent::Zero(), Tangent::Zero()};
+  const std::size_t n = observations.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Scalar t = problem.t[i], w = problem.w[i];
+    const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
+    residuals[i] = r;
+    const SinCos t_half = SinCos::of(t * forward.theta / 2);
+    const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
+    force.v0 += w * Psi::apply(backward, 1 - t, u_half, t_half, r);
+    force.v1 += w * Psi::apply(forward, t, t_half, u_half, r);
+  }
+  return force;
+}
+
+}  // namespace estimating_detail
+
+// Evaluates x, ad_x, the series order and the force at (g0, g1), writing
+// the residuals there into `residuals` (sized N). Outside the series' disc
+// (spectral radius of ad_x at or above 2 pi) only x and ad_x are set.
+template <class G, class Observations>
+State<G> evaluate(const Observations& observations, const Problem<typename G::Scalar>& problem,
+                  const PsiEvaluation& psi, const typename G::Element& g0,
+                  const typename G::Element& g1, std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
+  State<G> state;
+  state.g0 = g0;
+  state.g1 = g1;
+  state.x = log_at<G>(g0, g1);
+  state.a = G::ad(state.x);
+  if (!(ad_spectral_radius<G>(state.x) < kTwoPi)) {
+    state.series_converges = false;
+    return state;
+  }
+  if constexpr (has_closed_form_psi_v<G>) {
+    if (psi.method == Method::exact &&
+        G::ClosedFormPsi::angle(state.x) >= static_cast<Scalar>(kExactMinAngle)) {
+      state.force =
+          estimating_detail::closed_form_force<G>(observations, problem, g0, state.x, residuals);
+      return state;
+    }
+  }
+  if (psi.method == Method::series && psi.series_order > 0) {
+    state.order = psi.series_order;
+  } else {
+    std::tie(state.order, state.truncation) = adaptive_series_order(
+        state.a, std::numeric_limits<Scalar>::epsilon(), psi.max_series_order);
+  }
+  state.force = estimating_detail::series_force<G>(observations, problem, g0, state.x, state.a,
+                                                   state.order, residuals);
+  return state;
+}
+
+}  // namespace bireg

@@ -1,0 +1,169 @@
+// bireg: the iteration g0 <- g0 exp(d0), g1 <- g1 exp(d1) (the paper's
+// Section 2.2 for the paper step; any step rule of solver.hpp), run until
+// the step proposed at the current endpoints is at or below the tolerance.
+// Those endpoints are returned: the step certifies them, and is not taken.
+//
+// Safeguard (rules with `safeguarded`): a step that would increase ||v|| is
+// halved, up to kMaxHalvings times, so a fast step cannot overshoot where
+// the paper's step converges (a full step on a long geodesic can carry an
+// endpoint past pi). The test uses the Euclidean norm of v in
+// left-trivialised coordinates: left-invariant, and only approximately
+// right-invariant on groups without a bi-invariant metric (SE(3)), which
+// matters only for a borderline halving decision.
+//
+// Trial steps are evaluated into a second residual buffer, swapped in when
+// the step is taken, so a rejected trial costs nothing to undo. Both buffers
+// and the history are reserved before the loop: no heap allocation inside
+// it (beyond kReservedHistory iterations the history grows geometrically).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "bireg/geodesic.hpp"
+#include "bireg/regression/estimating_equations.hpp"
+#include "bireg/regression/problem.hpp"
+#include "bireg/regression/status.hpp"
+
+namespace bireg {
+
+// Iterations without a new smallest step, all below the rounding level,
+// after which a fit stops with Status::rounding_floor. Every solver shrinks
+// its step at least linearly while it can, so 10 iterations with no progress
+// mean rounding dominates: e.g. similarities at scale e^-20 carrying an
+// O(1) translation keep only ~1e-7 of their detail in double.
+inline constexpr int kStallIterations = 10;
+
+// Iterations whose history is reserved up front (more grow the vectors).
+inline constexpr int kReservedHistory = 1024;
+
+template <class Scalar>
+struct IterationControl {
+  Scalar tolerance;
+  int max_iterations;
+  bool record_iterates;
+};
+
+// What the iteration did, for the result and its diagnostics.
+template <class G>
+struct IterationRecord {
+  Status status = Status::max_iterations;
+  int iterations = 0;  // evaluations of the step (the last certifies a converged fit)
+  int backtracks = 0;  // safeguard halvings
+  std::vector<typename G::Scalar> step_norms;  // every proposed step, before halving
+  std::vector<std::pair<typename G::Element, typename G::Element>> iterates;  // if recorded
+};
+
+// Runs the iteration from (start0, start1), or from (fallback, fallback)
+// when that start is unusable. Returns the state at the returned endpoints,
+// whose residuals are in `residuals` (sized N). Every state it returns has
+// a convergent series and a finite force, hence finite residuals, except
+// when even the fallback start (X = 0) is unusable, which cannot happen.
+template <class G, class Rule, class Observations>
+State<G> iterate(const Observations& observations, const Problem<typename G::Scalar>& problem,
+                 const PsiEvaluation& psi, const Rule& rule,
+                 const IterationControl<typename G::Scalar>& control,
+                 const typename G::Element& start0, const typename G::Element& start1,
+                 const typename G::Element& fallback, std::vector<typename G::Tangent>& residuals,
+                 IterationRecord<G>& record) {
+  using Scalar = typename G::Scalar;
+  using std::isfinite;
+  using std::sqrt;
+  // A step this much larger than the smallest one seen means the iteration
+  // left the basin where it contracts, unless both are at the rounding
+  // level (below sqrt(epsilon), or the tolerance), where steps fluctuate by
+  // orders of magnitude without meaning anything.
+  constexpr Scalar kDivergenceGrowth = Scalar(1e3);
+  const Scalar sqrt_epsilon = sqrt(std::numeric_limits<Scalar>::epsilon());
+  const Scalar divergence_floor = kDivergenceGrowth * std::max(control.tolerance, sqrt_epsilon);
+  constexpr int kMaxHalvings = 20;
+
+  const std::size_t reserved =
+      static_cast<std::size_t>(std::min(control.max_iterations, kReservedHistory));
+  record.step_norms.reserve(reserved);
+  if (control.record_iterates) record.iterates.reserve(reserved);
+  record.status = Status::max_iterations;
+  residuals.resize(observations.size());
+  std::vector<typename G::Tangent> trial_residuals(observations.size());
+
+  int iterations_without_progress = 0;
+  Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
+  State<G> state = evaluate<G>(observations, problem, psi, start0, start1, residuals);
+  // A start beyond the series' disc or the log's domain (an extrapolated
+  // chart line on a matrix group, a far initial guess): start from the
+  // middle observation instead.
+  if (!state.usable()) {
+    state = evaluate<G>(observations, problem, psi, fallback, fallback, residuals);
+  }
+  for (int iteration = 0; iteration < control.max_iterations; ++iteration) {
+    if (!state.series_converges) {
+      record.status = Status::series_diverged;
+      return state;
+    }
+    const auto [d0, d1] = rule(state);
+    const Scalar step_norm = sqrt(d0.squaredNorm() + d1.squaredNorm());
+    if (!isfinite(step_norm) ||
+        (step_norm > kDivergenceGrowth * smallest_step && step_norm > divergence_floor)) {
+      record.status = Status::diverged;
+      return state;
+    }
+    record.step_norms.push_back(step_norm);
+    record.iterations = iteration + 1;
+    if (rule.convergence_norm(step_norm, state) <= control.tolerance) {
+      record.status = Status::converged;
+      return state;
+    }
+    // Steps below sqrt(epsilon) relative to the geodesic's size are at the
+    // rounding level, where they fluctuate without meaning.
+    const Scalar rounding_level = std::max(
+        control.tolerance, sqrt_epsilon * std::max(Scalar(1), sqrt(state.x.squaredNorm())));
+    if (step_norm < smallest_step) {
+      smallest_step = step_norm;
+      iterations_without_progress = 0;
+    } else if (control.tolerance > 0 && step_norm <= rounding_level &&
+               ++iterations_without_progress >= kStallIterations) {
+      record.status = Status::rounding_floor;
+      return state;
+    }
+
+    State<G> next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, d0),
+                                exp_at<G>(state.g1, d1), trial_residuals);
+    if constexpr (Rule::safeguarded) {
+      const Scalar force_norm = state.force.norm();
+      const auto acceptable = [&](const State<G>& trial) {
+        return trial.series_converges && trial.force.norm() <= force_norm;
+      };
+      Scalar fraction = 1;
+      for (int halving = 0; halving < kMaxHalvings && !acceptable(next); ++halving) {
+        fraction /= 2;
+        ++record.backtracks;
+        next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, fraction * d0),
+                           exp_at<G>(state.g1, fraction * d1), trial_residuals);
+      }
+      // Every halving failed: no step along this direction decreases the
+      // force. Above the rounding level that means the data are outside
+      // the estimator's domain; stop rather than wander.
+      if (!acceptable(next) && step_norm > rounding_level) {
+        record.status = Status::no_descent;
+        return state;
+      }
+    }
+    // The step left the series' disc, or the domain of the group's log
+    // (MatrixGroup returns NaN there, so the force is not finite). Keep the
+    // last usable endpoints.
+    if (!next.usable()) {
+      record.status = next.series_converges ? Status::diverged : Status::series_diverged;
+      return state;
+    }
+    state = next;
+    std::swap(residuals, trial_residuals);
+    if (control.record_iterates) record.iterates.emplace_back(state.g0, state.g1);
+  }
+  return state;
+}
+
+}  // namespace bireg

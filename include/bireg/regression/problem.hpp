@@ -1,0 +1,167 @@
+// bireg: the normalised data a fit works on, validated before any work.
+//
+// Covariates are mapped affinely onto the unit interval [0, 1] on which the
+// paper defines the estimator (DESIGN.md section 1): by default t_min, the
+// smallest covariate, goes to 0 and t_max, the largest, to 1; an explicit
+// interval fixes both ends instead (the estimator depends on that choice, so
+// fits of subsets or local fits that must be comparable need it). The map
+// is computed in double (or in Scalar where that is wider), whatever the
+// Scalar: float covariates such as 1.7e9 + 0.01 i would otherwise collapse.
+//
+// Weights are divided by the largest one before any sum: scaling all weights
+// changes nothing in the estimator, and uniform weights of 1e300 or 1e-300
+// would otherwise overflow or underflow the sums below.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace bireg {
+
+// Why a fit was refused, and the observation at fault (-1: none).
+struct Rejection {
+  std::string message;
+  std::ptrdiff_t index = -1;
+};
+
+// The wider of double and Scalar: the precision of the covariate map.
+template <class Scalar>
+using CovariateScalar =
+    std::conditional_t<(std::numeric_limits<Scalar>::digits > std::numeric_limits<double>::digits),
+                       Scalar, double>;
+
+template <class Scalar>
+struct Problem {
+  using Wide = CovariateScalar<Scalar>;
+  std::vector<Scalar> t;  // covariates mapped onto [0, 1]
+  std::vector<Scalar> w;  // weights divided by the largest
+  Wide t_min = 0, t_max = 1;
+  // H = [a b; b c] of Lemma 3.7, a = sum w (1-t)^2, b = sum w t (1-t),
+  // c = sum w t^2, and its eigenvalues.
+  Scalar a = 0, b = 0, c = 0;
+  Scalar mu_min = 0, mu_max = 0;
+  Scalar weight_sum = 0;
+
+  std::size_t size() const { return t.size(); }
+  Scalar determinant() const { return a * c - b * b; }
+};
+
+namespace problem_detail {
+template <class Scalar>
+bool finite(Scalar x) {
+  using std::isfinite;
+  return isfinite(x);
+}
+}  // namespace problem_detail
+
+// Builds the problem from n covariates and optional weights (empty: all 1)
+// and an optional interval (first < second, containing every covariate).
+template <class Scalar, class Covariates>
+std::optional<Rejection> make_problem(
+    const Covariates& covariates, const std::vector<Scalar>& weights,
+    const std::optional<std::pair<CovariateScalar<Scalar>, CovariateScalar<Scalar>>>& interval,
+    Problem<Scalar>& problem) {
+  using problem_detail::finite;
+  using std::sqrt;
+  using Wide = CovariateScalar<Scalar>;
+  const std::size_t n = covariates.size();
+  const auto index = [](std::size_t i) { return static_cast<std::ptrdiff_t>(i); };
+  if (!weights.empty() && weights.size() != n) {
+    return Rejection{"weights and observations differ in length (" +
+                     std::to_string(weights.size()) + " vs " + std::to_string(n) + ")"};
+  }
+  std::vector<Wide> wide(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    wide[i] = static_cast<Wide>(covariates[i]);
+    if (!finite(wide[i])) {
+      return Rejection{"covariate " + std::to_string(i) + " is not finite", index(i)};
+    }
+  }
+  Scalar largest_weight = 0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    if (!(weights[i] >= 0) || !finite(weights[i])) {
+      return Rejection{"weight " + std::to_string(i) + " is negative or not finite", index(i)};
+    }
+    largest_weight = std::max(largest_weight, weights[i]);
+  }
+  if (!weights.empty() && !(largest_weight > 0)) return Rejection{"all weights are zero"};
+
+  if (interval) {
+    const auto [low, high] = *interval;
+    if (!finite(low) || !finite(high) || !(low < high) || !finite(high - low)) {
+      return Rejection{"the covariate interval needs finite ends with first < second"};
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (wide[i] < low || wide[i] > high) {
+        return Rejection{"covariate " + std::to_string(i) + " lies outside the covariate interval",
+                         index(i)};
+      }
+    }
+    problem.t_min = low;
+    problem.t_max = high;
+  } else {
+    const auto [min_it, max_it] = std::minmax_element(wide.begin(), wide.end());
+    problem.t_min = *min_it;
+    problem.t_max = *max_it;
+  }
+  const Wide range = problem.t_max - problem.t_min;
+  if (!(range > 0) || !finite(range)) {
+    return Rejection{range > 0 ? "covariate range overflows"
+                               : "all covariates are equal: the slope is not identifiable"};
+  }
+  problem.t.resize(n);
+  problem.w.assign(n, Scalar(1));
+  for (std::size_t i = 0; i < n; ++i) {
+    problem.t[i] =
+        static_cast<Scalar>(std::clamp((wide[i] - problem.t_min) / range, Wide(0), Wide(1)));
+    if (!weights.empty()) problem.w[i] = weights[i] / largest_weight;
+  }
+
+  // H of Lemma 3.7, and its eigenvalues in a cancellation-free form.
+  for (std::size_t i = 0; i < n; ++i) {
+    const Scalar t = problem.t[i], w = problem.w[i];
+    problem.a += w * (1 - t) * (1 - t);
+    problem.b += w * t * (1 - t);
+    problem.c += w * t * t;
+    problem.weight_sum += w;
+  }
+  const Scalar half_trace = (problem.a + problem.c) / 2;
+  const Scalar half_gap = (problem.a - problem.c) / 2;
+  problem.mu_max = half_trace + sqrt(half_gap * half_gap + problem.b * problem.b);
+  problem.mu_min = problem.mu_max > 0 ? problem.determinant() / problem.mu_max : Scalar(0);
+  // mu_min is computed to ~eps mu_max; below a few of those it is noise.
+  if (!(problem.mu_min > 16 * std::numeric_limits<Scalar>::epsilon() * problem.mu_max)) {
+    return Rejection{
+        "the observations with positive weight share one covariate: the slope is not "
+        "identifiable (mu_min = 0)"};
+  }
+  return std::nullopt;
+}
+
+// Every observation finite and in the group (to `tolerance`).
+template <class G, class Observations>
+std::optional<Rejection> check_observations(const Observations& observations,
+                                            typename G::Scalar tolerance) {
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const typename G::Element& f = observations[i];
+    const auto index = static_cast<std::ptrdiff_t>(i);
+    if (!f.allFinite()) {
+      return Rejection{"observation " + std::to_string(i) + " has non-finite entries", index};
+    }
+    if (!G::is_element(f, tolerance)) {
+      return Rejection{"observation " + std::to_string(i) + " is not an element of " + G::name +
+                           " (to tolerance " + std::to_string(double(tolerance)) + ")",
+                       index};
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace bireg

@@ -1,0 +1,93 @@
+// bireg: where the iteration starts, from one pass over the data in the log
+// chart at f_ref, the observation nearest the middle of the covariate range,
+// y_i = log(f_ref^{-1} f_i). It gives
+//
+//  * the default start: the weighted least-squares line y_i ~ (1 - t_i) x0
+//    + t_i x1, i.e. (x0, x1) = (H^{-1} kron I)(sum w (1-t) y, sum w t y),
+//    (g0, g1) = (f_ref exp(x0), f_ref exp(x1)). It is exact on commutative
+//    groups, first-order accurate otherwise, and, like the iteration,
+//    equivariant under left and right translation and inversion (the chart
+//    moves with f_ref), so the whole fit stays equivariant. The middle
+//    observation keeps the chart's distortion smallest for the endpoints;
+//  * the fallback start, f_ref as a constant geodesic, for a start whose
+//    geodesic leaves the series' disc or the log's domain;
+//  * the data's spread about their mean in that chart, sum w |y_i - ybar|^2:
+//    on commutative groups exactly the total sum of squares of ordinary
+//    regression; otherwise the spread about the bi-invariant mean up to
+//    terms of third order in the data's radius;
+//  * the check that the data fit in the scalar's range: every later sum
+//    squares tangent coordinates of the size of y_i, so |y_i| must stay
+//    below largest_tangent<Scalar>(). The check is on y_i, not on the
+//    observations, so it is left and right invariant like the fit: poses
+//    1e200 away from the origin but close to each other are fine.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+
+#include "bireg/geodesic.hpp"
+#include "bireg/regression/problem.hpp"
+
+namespace bireg {
+
+// The largest tangent coordinate the fit accepts: 2^-20 sqrt(max), so that
+// squares summed over up to 2^40 observations stay finite (1.3e148 in
+// double, 1.8e13 in float).
+template <class Scalar>
+Scalar largest_tangent() {
+  using std::sqrt;
+  return sqrt(std::numeric_limits<Scalar>::max()) / Scalar(1048576);
+}
+
+template <class G>
+struct ChartStart {
+  typename G::Element g0, g1;
+  typename G::Element reference;  // the observation nearest the middle of the covariates
+  typename G::Scalar spread = 0;
+  std::ptrdiff_t no_logarithm = -1;  // an observation whose log was not finite
+  std::ptrdiff_t too_large = -1;     // an observation whose |y_i| exceeds largest_tangent
+};
+
+template <class G, class Observations>
+ChartStart<G> chart_start(const Observations& observations,
+                          const Problem<typename G::Scalar>& problem) {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  const std::size_t n = observations.size();
+  std::size_t reference = 0;
+  for (std::size_t i = 1; i < n; ++i) {
+    using std::abs;
+    if (abs(problem.t[i] - Scalar(0.5)) < abs(problem.t[reference] - Scalar(0.5))) reference = i;
+  }
+  const typename G::Element& f_ref = observations[reference];
+  const typename G::Element f_ref_inverse = G::inverse(f_ref);
+  Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
+  Scalar square_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
+    const bool finite = y.allFinite();
+    if (!finite || y.cwiseAbs().maxCoeff() > largest_tangent<Scalar>()) {
+      ChartStart<G> outside;
+      outside.g0 = outside.g1 = outside.reference = f_ref;
+      (finite ? outside.too_large : outside.no_logarithm) = static_cast<std::ptrdiff_t>(i);
+      return outside;
+    }
+    moment0 += problem.w[i] * (1 - problem.t[i]) * y;
+    moment1 += problem.w[i] * problem.t[i] * y;
+    square_sum += problem.w[i] * y.squaredNorm();
+  }
+  const Scalar determinant = problem.determinant();
+  const Tangent x0 = (problem.c * moment0 - problem.b * moment1) / determinant;
+  const Tangent x1 = (problem.a * moment1 - problem.b * moment0) / determinant;
+  const Tangent total = moment0 + moment1;  // sum w y
+  ChartStart<G> chart;
+  chart.reference = f_ref;
+  chart.g0 = exp_at<G>(f_ref, x0);
+  chart.g1 = exp_at<G>(f_ref, x1);
+  chart.spread = std::max(Scalar(0), square_sum - total.squaredNorm() / problem.weight_sum);
+  return chart;
+}
+
+}  // namespace bireg
