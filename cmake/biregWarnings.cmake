@@ -2,6 +2,9 @@
 # examples, benchmarks). The library target itself carries no flags:
 # consumers choose their own.
 #
+# BIREG_WERROR (option in the top-level CMakeLists.txt, default OFF, ON in
+# CI) adds -Werror (/WX).
+#
 # BIREG_SANITIZE: a -fsanitize= list such as "address,undefined" for the
 # tests, examples and tools (the CI sanitizer stage); empty by default.
 set(BIREG_SANITIZE "" CACHE STRING "Sanitizers for bireg's tests and tools, e.g. address,undefined")
@@ -13,8 +16,9 @@ function(bireg_enable_warnings target)
     target_link_options(${target} PRIVATE -fsanitize=${BIREG_SANITIZE})
   endif()
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
-    target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror)
+    target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic
+      $<$<BOOL:${BIREG_WERROR}>:-Werror>)
   elseif(MSVC)
-    target_compile_options(${target} PRIVATE /W4 /WX)
+    target_compile_options(${target} PRIVATE /W4 $<$<BOOL:${BIREG_WERROR}>:/WX>)
   endif()
 endfunction()

@@ -3,12 +3,13 @@
 #include <cstdio>
 
 #include <bireg/groups/se3.hpp>
+#include <bireg/version.hpp>  // generated: installed, or in bireg's build tree
 
 int main() {
   using G = bireg::SE3<double>;
   G::Tangent xi;
   xi << 0.1, -0.2, 0.3, 0.4, 0.5, -0.6;
   const double error = (G::log(G::exp(xi)) - xi).norm();
-  std::printf("consumer: SE3 log(exp(xi)) error %.3g\n", error);
+  std::printf("consumer: bireg %s, SE3 log(exp(xi)) error %.3g\n", bireg::version, error);
   return error < 1e-12 ? 0 : 1;
 }

@@ -13,7 +13,7 @@ endfunction()
 
 run_step(${CMAKE_COMMAND} --install ${BIREG_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
 
-foreach(mode find_package subdirectory)
+foreach(mode find_package subdirectory subdirectory_own_eigen)
   set(build ${WORK_DIR}/build_${mode})
   run_step(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${build} -G ${GENERATOR}
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER}

@@ -1,0 +1,6 @@
+// No log(Element).
+// expect-error: bireg group concept: G needs static exp(Tangent) -> Element and log(Element) -> Tangent
+#define BIREG_TOY_NO_LOG
+#include "toy_group.hpp"
+
+static_assert(bireg::check_lie_group<Toy>());

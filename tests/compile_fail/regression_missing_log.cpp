@@ -1,0 +1,10 @@
+// What a user meets: the regression over a group without log(Element)
+// stops at the concept's message, not deep inside the solver.
+// expect-error: bireg group concept: G needs static exp(Tangent) -> Element and log(Element) -> Tangent
+#define BIREG_TOY_NO_LOG
+#include "toy_group.hpp"
+
+int main() {
+  bireg::GeodesicRegression<Toy> regression;
+  (void)regression;
+}
