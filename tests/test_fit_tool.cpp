@@ -18,8 +18,8 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
@@ -111,10 +111,10 @@ typename G::Element element_of(const std::vector<double>& numbers) {
 }
 
 template <class G>
-bireg::tools::Trajectory<G> read_file(const std::string& path, bireg::tools::Format format) {
+bireg::io::Trajectory<G> read_file(const std::string& path, bireg::io::Format format) {
   std::ifstream in(path);
-  bireg::tools::Trajectory<G> trajectory;
-  REQUIRE_FALSE(bireg::tools::read_trajectory<G>(in, format, trajectory).has_value());
+  bireg::io::Trajectory<G> trajectory;
+  REQUIRE_FALSE(bireg::io::read_trajectory<G>(in, format, trajectory).has_value());
   return trajectory;
 }
 
@@ -123,7 +123,7 @@ bireg::tools::Trajectory<G> read_file(const std::string& path, bireg::tools::For
 // between the two binaries, which stays at rounding level amplified by the
 // iteration's condition: 1e-12 relative.
 template <class G>
-void check_against_library(const std::string& file, bireg::tools::Format format,
+void check_against_library(const std::string& file, bireg::io::Format format,
                            const std::string& args) {
   const Run run = run_tool(args + " \"" + data(file) + "\"");
   CAPTURE(run.err);
@@ -151,7 +151,7 @@ void check_against_library(const std::string& file, bireg::tools::Format format,
 }  // namespace
 
 TEST_CASE("bireg_fit reads both formats and agrees with the library", "[tool]") {
-  using bireg::tools::Format;
+  using bireg::io::Format;
   check_against_library<bireg::SO3<double>>("so3_small.csv", Format::matrix, "--group SO3");
   check_against_library<bireg::SE3<double>>("se3_small.tum", Format::tum,
                                             "--group SE3 --format tum");
@@ -257,8 +257,8 @@ TEST_CASE("bireg_fit --output-trajectory writes the fitted geodesic in the input
   const Run run = run_tool("--group SE3 --format tum --output-trajectory \"" + out + "\" \"" +
                            data("se3_small.tum") + "\"");
   REQUIRE(run.exit_code == 0);
-  const auto input = read_file<G>(data("se3_small.tum"), bireg::tools::Format::tum);
-  const auto fitted = read_file<G>(out, bireg::tools::Format::tum);
+  const auto input = read_file<G>(data("se3_small.tum"), bireg::io::Format::tum);
+  const auto fitted = read_file<G>(out, bireg::io::Format::tum);
   REQUIRE(fitted.covariates == input.covariates);
   const G::Element g0 = element_of<G>(json_numbers(run.out, "g0"));
   const G::Element g1 = element_of<G>(json_numbers(run.out, "g1"));

@@ -26,8 +26,8 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 namespace {
 
@@ -36,10 +36,10 @@ void require(bool condition) {
 }
 
 template <class G>
-void exercise(const std::string& text, bireg::tools::Format format, bireg::Solver solver) {
+void exercise(const std::string& text, bireg::io::Format format, bireg::Solver solver) {
   std::istringstream in(text);
-  bireg::tools::Trajectory<G> trajectory;
-  const auto error = bireg::tools::read_trajectory<G>(in, format, trajectory);
+  bireg::io::Trajectory<G> trajectory;
+  const auto error = bireg::io::read_trajectory<G>(in, format, trajectory);
   if (error) {
     require(!error->message.empty());
     require(error->line >= 0);
@@ -72,7 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t selector = data[0];
   const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
-  const auto format = (selector & 4) ? bireg::tools::Format::tum : bireg::tools::Format::matrix;
+  const auto format = (selector & 4) ? bireg::io::Format::tum : bireg::io::Format::matrix;
   const auto solver = (selector & 8) ? bireg::Solver::paper : bireg::Solver::gauss_newton;
   switch ((selector & 3) | ((selector >> 2) & 4)) {  // bits 0, 1 and 4
     case 0:

@@ -1,4 +1,4 @@
-// bireg tools: reading and writing trajectories as text, for bireg_fit and
+// bireg io: reading and writing trajectories as text, for bireg_fit and
 // the demo. Uses the standard library only and never throws on bad input:
 // every problem is returned as a ParseError naming the line.
 //
@@ -28,7 +28,7 @@
 #include "bireg/groups/so3.hpp"
 
 namespace bireg {
-namespace tools {
+namespace io {
 
 enum class Format { matrix, tum };
 
@@ -203,5 +203,5 @@ std::string json_matrix(const Matrix& m) {
   return s + "]";
 }
 
-}  // namespace tools
+}  // namespace io
 }  // namespace bireg

@@ -28,8 +28,8 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 namespace {
 
@@ -45,7 +45,7 @@ constexpr const char* kUsage =
 
 struct Command {
   std::string group;
-  bireg::tools::Format format = bireg::tools::Format::matrix;
+  bireg::io::Format format = bireg::io::Format::matrix;
   bireg::Method method = bireg::Method::exact;
   int order = 0;
   bireg::Solver solver = bireg::Solver::gauss_newton;
@@ -94,9 +94,9 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       command.group = *v;
     } else if (arg == "--format") {
       if (*v == "matrix") {
-        command.format = bireg::tools::Format::matrix;
+        command.format = bireg::io::Format::matrix;
       } else if (*v == "tum") {
-        command.format = bireg::tools::Format::tum;
+        command.format = bireg::io::Format::tum;
       } else {
         return "unknown format '" + *v + "' (matrix or tum)";
       }
@@ -157,7 +157,7 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
 }
 
 std::string json_number(double x) {
-  return std::isfinite(x) ? bireg::tools::format_double(x) : std::string("null");
+  return std::isfinite(x) ? bireg::io::format_double(x) : std::string("null");
 }
 
 template <class G>
@@ -171,8 +171,8 @@ int run(const Command& command) {
   }
   std::istream& in = command.input == "-" ? std::cin : file;
 
-  bireg::tools::Trajectory<G> trajectory;
-  if (const auto error = bireg::tools::read_trajectory<G>(in, command.format, trajectory)) {
+  bireg::io::Trajectory<G> trajectory;
+  if (const auto error = bireg::io::read_trajectory<G>(in, command.format, trajectory)) {
     const std::string where = error->line > 0 ? name + ":" + std::to_string(error->line) : name;
     return fail(where + ": " + error->message);
   }
@@ -206,8 +206,8 @@ int run(const Command& command) {
       "\"force_norm\": %s, "
       "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
       G::name, trajectory.observations.size(),
-      bireg::tools::json_matrix(result.geodesic.start()).c_str(),
-      bireg::tools::json_matrix(result.geodesic.end()).c_str(),
+      bireg::io::json_matrix(result.geodesic.start()).c_str(),
+      bireg::io::json_matrix(result.geodesic.end()).c_str(),
       json_number(result.geodesic.t_min()).c_str(), json_number(result.geodesic.t_max()).c_str(),
       bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
       json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
@@ -220,7 +220,7 @@ int run(const Command& command) {
     std::ofstream out(command.output_trajectory);
     if (!out) return fail(command.output_trajectory + ": cannot write file");
     for (double t : trajectory.covariates) {
-      out << bireg::tools::format_observation<G>(command.format, t, result.geodesic(t)) << '\n';
+      out << bireg::io::format_observation<G>(command.format, t, result.geodesic(t)) << '\n';
     }
   }
   return result.ok() ? 0 : kExitNotConverged;
