@@ -126,8 +126,8 @@ bool fit_file(const std::string& path, bireg::io::Format format, Fitted<G>& out)
     return false;
   }
   if (const auto error = bireg::io::read_trajectory<G>(in, format, out.data)) {
-    std::fprintf(stderr, "bireg_demo: %s:%d: %s\n", path.c_str(), error->line,
-                 error->message.c_str());
+    std::fprintf(stderr, "bireg_demo: %s:%llu: %s\n", path.c_str(),
+                 static_cast<unsigned long long>(error->line), error->message.c_str());
     return false;
   }
   const bireg::GeodesicRegression<G> regression;
