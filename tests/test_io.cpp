@@ -381,8 +381,9 @@ TEST_CASE("format detection by content, ambiguity named", "[io]") {
   REQUIRE(read_ok<bireg::SE2<double>>("0 1 0 0 0 1 0 0 0 1\n").format == Format::matrix);
 }
 
-TEST_CASE("--project: quaternions normalised, rotation blocks projected, degenerate refused",
-          "[io]") {
+TEST_CASE(
+    "projection (--project): quaternions normalised, rotation blocks projected, degenerate refused",
+    "[io]") {
   bireg::io::ReadOptions strict, project;
   project.project = true;
   const std::string tum = "0 0 0 0 0 0 0 1.01\n1 1 0 0 0 0 0 1\n";
