@@ -18,8 +18,8 @@
 
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 #ifndef BIREG_DEMO_DATA_DIR
 #define BIREG_DEMO_DATA_DIR "examples/data"
@@ -112,22 +112,22 @@ std::string svg_panels(const std::string& title, const std::vector<double>& t,
 
 template <class G>
 struct Fitted {
-  bireg::tools::Trajectory<G> data;
+  bireg::io::Trajectory<G> data;
   typename bireg::GeodesicRegression<G>::Result result;
   double milliseconds = 0;
 };
 
 // Reads and fits one trajectory; the fit is repeated to time it reliably.
 template <class G>
-bool fit_file(const std::string& path, bireg::tools::Format format, Fitted<G>& out) {
+bool fit_file(const std::string& path, bireg::io::Format format, Fitted<G>& out) {
   std::ifstream in(path);
   if (!in) {
     std::fprintf(stderr, "bireg_demo: cannot open %s\n", path.c_str());
     return false;
   }
-  if (const auto error = bireg::tools::read_trajectory<G>(in, format, out.data)) {
-    std::fprintf(stderr, "bireg_demo: %s:%d: %s\n", path.c_str(), error->line,
-                 error->message.c_str());
+  if (const auto error = bireg::io::read_trajectory<G>(in, format, out.data)) {
+    std::fprintf(stderr, "bireg_demo: %s:%llu: %s\n", path.c_str(),
+                 static_cast<unsigned long long>(error->line), error->message.c_str());
     return false;
   }
   const bireg::GeodesicRegression<G> regression;
@@ -184,7 +184,7 @@ int main(int argc, char** argv) {
   // x-IMU: a rotation, SO(3).
   using Rotation = bireg::SO3<double>;
   Fitted<Rotation> imu;
-  if (!fit_file(data_dir + "/so3_xio_imu_window.csv", bireg::tools::Format::matrix, imu)) return 1;
+  if (!fit_file(data_dir + "/so3_xio_imu_window.csv", bireg::io::Format::matrix, imu)) return 1;
   {
     const auto& r = imu.result;
     const double seconds = r.geodesic->t_max() - r.geodesic->t_min();
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
   // DeepMimic walk: a rigid motion, SE(3) (tangent = translation, rotation).
   using Pose = bireg::SE3<double>;
   Fitted<Pose> walk;
-  if (!fit_file(data_dir + "/se3_deepmimic_walk.tum", bireg::tools::Format::tum, walk)) return 1;
+  if (!fit_file(data_dir + "/se3_deepmimic_walk.tum", bireg::io::Format::tum, walk)) return 1;
   {
     const auto& r = walk.result;
     const double seconds = r.geodesic->t_max() - r.geodesic->t_min();

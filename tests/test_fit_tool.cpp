@@ -5,9 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,14 +22,17 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
+#include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+
+bool json_has_non_finite(const std::string& json);
 
 struct Run {
   int exit_code = -1;
@@ -111,10 +118,10 @@ typename G::Element element_of(const std::vector<double>& numbers) {
 }
 
 template <class G>
-bireg::tools::Trajectory<G> read_file(const std::string& path, bireg::tools::Format format) {
+bireg::io::Trajectory<G> read_file(const std::string& path, bireg::io::Format format) {
   std::ifstream in(path);
-  bireg::tools::Trajectory<G> trajectory;
-  REQUIRE_FALSE(bireg::tools::read_trajectory<G>(in, format, trajectory).has_value());
+  bireg::io::Trajectory<G> trajectory;
+  REQUIRE_FALSE(bireg::io::read_trajectory<G>(in, format, trajectory).has_value());
   return trajectory;
 }
 
@@ -123,7 +130,7 @@ bireg::tools::Trajectory<G> read_file(const std::string& path, bireg::tools::For
 // between the two binaries, which stays at rounding level amplified by the
 // iteration's condition: 1e-12 relative.
 template <class G>
-void check_against_library(const std::string& file, bireg::tools::Format format,
+void check_against_library(const std::string& file, bireg::io::Format format,
                            const std::string& args) {
   const Run run = run_tool(args + " \"" + data(file) + "\"");
   CAPTURE(run.err);
@@ -131,7 +138,7 @@ void check_against_library(const std::string& file, bireg::tools::Format format,
   REQUIRE(run.err.empty());
   REQUIRE(json_string(run.out, "status") == "converged");
   REQUIRE(json_string(run.out, "group") == G::name);
-  REQUIRE(run.out.find("nan") == std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(run.out));
 
   const auto trajectory = read_file<G>(data(file), format);
   const auto result =
@@ -141,8 +148,11 @@ void check_against_library(const std::string& file, bireg::tools::Format format,
                                      result.geodesic->start()) <= 1e-12);
   REQUIRE(bireg_test::relative_error(element_of<G>(json_numbers(run.out, "g1")),
                                      result.geodesic->end()) <= 1e-12);
-  REQUIRE(json_numbers(run.out, "t_min").at(0) == result.geodesic->t_min());
-  REQUIRE(json_numbers(run.out, "t_max").at(0) == result.geodesic->t_max());
+  // t_min and t_max are the earliest and latest timestamps, written exactly;
+  // the fit's covariates count from the earliest.
+  REQUIRE(json_numbers(run.out, "t_min").at(0) == trajectory.origin.seconds);
+  REQUIRE(json_numbers(run.out, "t_max").at(0) == trajectory.last.seconds);
+  REQUIRE(result.geodesic->t_min() == 0);
   REQUIRE(json_numbers(run.out, "iterations").at(0) == result.iterations);
   REQUIRE(std::abs(json_numbers(run.out, "residual_rms").at(0) - result.diagnostics.residual_rms) <=
           1e-12 * result.diagnostics.residual_rms);
@@ -151,7 +161,7 @@ void check_against_library(const std::string& file, bireg::tools::Format format,
 }  // namespace
 
 TEST_CASE("bireg_fit reads both formats and agrees with the library", "[tool]") {
-  using bireg::tools::Format;
+  using bireg::io::Format;
   check_against_library<bireg::SO3<double>>("so3_small.csv", Format::matrix, "--group SO3");
   check_against_library<bireg::SE3<double>>("se3_small.tum", Format::tum,
                                             "--group SE3 --format tum");
@@ -204,6 +214,9 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
       {"--group SE3 --format tum", "bad_quaternion.tum",
        "bad_quaternion.tum:2: quaternion norm 0.5 is far from 1"},
       {"--group SE3 --format tum", "wrong_columns.tum", "wrong_columns.tum:2: expected 8 numbers"},
+      {"--group SO3", "extra_columns.csv", "extra_columns.csv:3: expected 10 numbers, found 11"},
+      {"--group SE3 --format tum", "extra_columns.tum",
+       "extra_columns.tum:2: expected 8 numbers (timestamp tx ty tz qx qy qz qw), found 9"},
       {"--group SE2 --format tum", "se3_small.tum",
        "the tum format holds SE3 or SO3 poses, not SE2"},
       {"--group SO3", "no_such_file.csv", "no_such_file.csv: cannot open file"},
@@ -246,7 +259,7 @@ TEST_CASE("bireg_fit exits with 3 and still prints the JSON when the fit does no
   REQUIRE(run.exit_code == 3);
   REQUIRE(json_string(run.out, "status") == "max_iterations");
   REQUIRE(json_numbers(run.out, "iterations").at(0) == 2);
-  REQUIRE(run.out.find("nan") == std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(run.out));
 }
 
 TEST_CASE("bireg_fit --output-trajectory writes the fitted geodesic in the input's format",
@@ -257,8 +270,8 @@ TEST_CASE("bireg_fit --output-trajectory writes the fitted geodesic in the input
   const Run run = run_tool("--group SE3 --format tum --output-trajectory \"" + out + "\" \"" +
                            data("se3_small.tum") + "\"");
   REQUIRE(run.exit_code == 0);
-  const auto input = read_file<G>(data("se3_small.tum"), bireg::tools::Format::tum);
-  const auto fitted = read_file<G>(out, bireg::tools::Format::tum);
+  const auto input = read_file<G>(data("se3_small.tum"), bireg::io::Format::tum);
+  const auto fitted = read_file<G>(out, bireg::io::Format::tum);
   REQUIRE(fitted.covariates == input.covariates);
   const G::Element g0 = element_of<G>(json_numbers(run.out, "g0"));
   const G::Element g1 = element_of<G>(json_numbers(run.out, "g1"));
@@ -268,5 +281,458 @@ TEST_CASE("bireg_fit --output-trajectory writes the fitted geodesic in the input
   for (std::size_t i = 0; i < fitted.observations.size(); ++i) {
     REQUIRE(bireg_test::relative_error(fitted.observations[i], geodesic(input.covariates[i])) <=
             1e-14);
+  }
+}
+
+// ---- the io/ layer through the tool: formats, timestamps, hostile input ----
+
+namespace {
+
+// True when the JSON holds a non-finite number however it is spelled: null,
+// nan, inf, infinity (any case, any sign, outside strings) or a number too
+// large for a double (1e999).
+bool json_has_non_finite(const std::string& json) {
+  bool in_string = false;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      if (c == '"') in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      continue;
+    }
+    if (std::isalpha(static_cast<unsigned char>(c))) {
+      std::size_t end = i;
+      std::string word;
+      while (end < json.size() && std::isalpha(static_cast<unsigned char>(json[end])))
+        word += static_cast<char>(std::tolower(static_cast<unsigned char>(json[end++])));
+      if (word == "null" || word == "nan" || word == "inf" || word == "infinity") return true;
+      i = end - 1;
+    } else if (c == '-' || c == '+' || c == '.' || (c >= '0' && c <= '9')) {
+      char* end = nullptr;
+      const double x = std::strtod(json.c_str() + i, &end);
+      if (end == json.c_str() + i) continue;
+      if (!std::isfinite(x)) return true;
+      i = static_cast<std::size_t>(end - json.c_str()) - 1;
+    }
+  }
+  return false;
+}
+
+std::string scratch(const std::string& name) {
+  return (work_dir() / (std::to_string(static_cast<long>(getpid())) + "_" + name)).string();
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  REQUIRE(out.good());
+}
+
+std::string quoted(const std::string& path) {
+  return "\"" + path + "\"";
+}
+
+std::string g17(double x) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
+// One trajectory: poses near a geodesic, timestamps 1.7e9 s + 0.01 i with
+// microsecond digits, written by hand (not by the io writers) in the four
+// formats.
+struct Sample {
+  std::vector<bireg::SE3<double>::Element> poses;
+  std::vector<std::string> seconds, nanoseconds;
+};
+
+Sample make_sample(int n) {
+  using G = bireg::SE3<double>;
+  std::mt19937 rng(11);
+  Sample s;
+  Eigen::Matrix<double, 6, 1> a, b;
+  a << 0.1, -0.2, 0.3, 1.0, 0.5, -0.25;
+  b << 0.6, 0.3, -0.2, 2.0, -1.0, 0.75;
+  for (int i = 0; i < n; ++i) {
+    const double u = static_cast<double>(i) / (n - 1);
+    const Eigen::Matrix<double, 6, 1> noise =
+        bireg_test::random_tangent<Eigen::Matrix<double, 6, 1>>(rng, 0.02);
+    s.poses.push_back(G::exp((1 - u) * a + u * b) * G::exp(noise));
+    const long micro = 10000L * i + (137L * i) % 1000;  // 0.01 i s plus microseconds
+    char seconds[40];
+    std::snprintf(seconds, sizeof seconds, "1700000000.%06ld", micro);
+    s.seconds.push_back(seconds);
+    s.nanoseconds.push_back("1700000000" + std::string(seconds + 11) + "000");
+  }
+  return s;
+}
+
+Eigen::Vector4d quaternion_wxyz(const Eigen::Matrix3d& r) {
+  return bireg::SO3<double>::to_quaternion(r);
+}
+
+std::string write_sample(const Sample& s, bireg::io::Format format) {
+  std::string text;
+  if (format == bireg::io::Format::euroc) text = "#timestamp [ns],x,y,z,qw,qx,qy,qz\n";
+  for (std::size_t i = 0; i < s.poses.size(); ++i) {
+    const auto& g = s.poses[i];
+    const Eigen::Vector4d q = quaternion_wxyz(g.topLeftCorner<3, 3>());
+    switch (format) {
+      case bireg::io::Format::matrix:
+        text += s.seconds[i];
+        for (int r = 0; r < 4; ++r)
+          for (int c = 0; c < 4; ++c)
+            text += ", " + g17(g(r, c));
+        break;
+      case bireg::io::Format::tum:
+        text += s.seconds[i] + " " + g17(g(0, 3)) + " " + g17(g(1, 3)) + " " + g17(g(2, 3)) + " " +
+                g17(q[1]) + " " + g17(q[2]) + " " + g17(q[3]) + " " + g17(q[0]);
+        break;
+      case bireg::io::Format::euroc:
+        text += s.nanoseconds[i] + "," + g17(g(0, 3)) + "," + g17(g(1, 3)) + "," + g17(g(2, 3)) +
+                "," + g17(q[0]) + "," + g17(q[1]) + "," + g17(q[2]) + "," + g17(q[3]) +
+                ",0.1,0.2,0.3";
+        break;
+      case bireg::io::Format::kitti:
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 4; ++c)
+            text += (r + c ? " " : "") + g17(g(r, c));
+        break;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+std::string times_file(const Sample& s) {
+  std::string text;
+  for (const auto& t : s.seconds)
+    text += t + "\n";
+  return text;
+}
+
+// Splits like Python's str.split(delimiter) (as evo's csv reader does).
+std::vector<std::string> split_exact(const std::string& line, char delimiter) {
+  std::vector<std::string> fields(1);
+  for (char c : line) {
+    if (c == delimiter) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+// A trajectory file read with evo's documented column conventions: '#' lines
+// skipped, TUM 8 space-separated fields (quaternion x y z w), KITTI 12
+// space-separated fields (3x4 row-major), EuRoC 17 comma-separated fields
+// (nanoseconds, position, quaternion w x y z). No trailing delimiters.
+struct EvoTrajectory {
+  std::vector<std::string> stamps;
+  std::vector<bireg::SE3<double>::Element> poses;
+};
+
+EvoTrajectory read_like_evo(const std::string& path, bireg::io::Format format) {
+  std::ifstream in(path);
+  std::string line;
+  EvoTrajectory out;
+  while (std::getline(in, line)) {
+    if (line.rfind("#", 0) == 0) continue;
+    const char delimiter = format == bireg::io::Format::euroc ? ',' : ' ';
+    const auto f = split_exact(line, delimiter);
+    const std::size_t expected = format == bireg::io::Format::tum     ? 8
+                                 : format == bireg::io::Format::kitti ? 12
+                                                                      : 17;
+    REQUIRE(f.size() == expected);
+    std::vector<double> x;
+    for (const auto& field : f) {
+      std::size_t used = 0;
+      x.push_back(std::stod(field, &used));
+      REQUIRE(used == field.size());
+    }
+    bireg::SE3<double>::Element g = bireg::SE3<double>::Element::Identity();
+    if (format == bireg::io::Format::kitti) {
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c)
+          g(r, c) = x[static_cast<std::size_t>(4 * r + c)];
+    } else {
+      const bool tum = format == bireg::io::Format::tum;
+      const double w = tum ? x[7] : x[4], qx = tum ? x[4] : x[5], qy = tum ? x[5] : x[6],
+                   qz = tum ? x[6] : x[7];
+      g.topLeftCorner<3, 3>() = bireg::io::rotation_of_quaternion(w, qx, qy, qz);
+      g.topRightCorner<3, 1>() = Eigen::Vector3d(x[1], x[2], x[3]);
+      out.stamps.push_back(f[0]);
+    }
+    out.poses.push_back(g);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("the non-finite check catches every spelling", "[tool]") {
+  REQUIRE_FALSE(
+      json_has_non_finite("{\"a\": [1, -2.5e-3, 0], \"status\": \"null nan inf\", \"b\": 1e308}"));
+  for (const char* bad : {"{\"a\": null}", "{\"a\": nan}", "{\"a\": NaN}", "{\"a\": -inf}",
+                          "{\"a\": Infinity}", "{\"a\": [1, -INF]}", "{\"a\": 1e999}"}) {
+    CAPTURE(bad);
+    REQUIRE(json_has_non_finite(bad));
+  }
+}
+
+TEST_CASE("bireg_fit: the same trajectory in all four formats gives the same fit", "[tool]") {
+  using bireg::io::Format;
+  const Sample sample = make_sample(40);
+  const std::string times = scratch("times.txt");
+  write_text(times, times_file(sample));
+  std::vector<std::vector<double>> g0s, g1s;
+  for (Format format : {Format::matrix, Format::tum, Format::euroc, Format::kitti}) {
+    CAPTURE(bireg::io::to_string(format));
+    const std::string file = scratch(std::string("four.") + bireg::io::to_string(format));
+    write_text(file, write_sample(sample, format));
+    const std::string times_arg = format == Format::kitti ? " --times " + quoted(times) : "";
+    for (const std::string& format_arg :
+         {std::string(), std::string(" --format ") + bireg::io::to_string(format)}) {
+      const Run run =
+          run_tool("--group SE3 --tol 1e-14" + format_arg + times_arg + " " + quoted(file));
+      CAPTURE(format_arg, run.err);
+      REQUIRE(run.exit_code == 0);
+      REQUIRE(json_string(run.out, "format") == bireg::io::to_string(format));
+      REQUIRE_FALSE(json_has_non_finite(run.out));
+      REQUIRE(json_numbers(run.out, "n").at(0) == 40);
+      // Exactly the first and the last timestamp, in seconds.
+      REQUIRE(run.out.find("\"t_min\": 1700000000,") != std::string::npos);
+      REQUIRE(run.out.find("\"t_max\": 1700000000.390343,") != std::string::npos);
+      g0s.push_back(json_numbers(run.out, "g0"));
+      g1s.push_back(json_numbers(run.out, "g1"));
+    }
+  }
+  for (std::size_t k = 1; k < g0s.size(); ++k) {
+    for (std::size_t i = 0; i < 16; ++i) {
+      REQUIRE(std::abs(g0s[k][i] - g0s[0][i]) <= 1e-12);
+      REQUIRE(std::abs(g1s[k][i] - g1s[0][i]) <= 1e-12);
+    }
+  }
+}
+
+TEST_CASE("bireg_fit: nanosecond timestamps at 1.7e18 keep every digit", "[tool]") {
+  using G = bireg::SE3<double>;
+  std::string text = "#timestamp [ns],x,y,z,qw,qx,qy,qz\n";
+  for (int i = 0; i < 5; ++i) {
+    text += std::to_string(1700000000000000000LL + i) + "," + std::to_string(0.5 * i) +
+            ",0,0,1,0,0,0\n";
+  }
+  const std::string file = scratch("ns.csv"), out = scratch("ns_fitted.csv");
+  write_text(file, text);
+  const Run run = run_tool("--group SE3 --output-trajectory " + quoted(out) + " " + quoted(file));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.out.find("\"t_max\": 1700000000.000000004,") != std::string::npos);
+  // Five distinct covariates 1e-9 s apart: translation 0.5 per ns exactly.
+  const G::Element g1 = element_of<G>(json_numbers(run.out, "g1"));
+  REQUIRE(std::abs(g1(0, 3) - 2.0) <= 1e-9);
+  REQUIRE(std::abs(json_numbers(run.out, "residual_rms").at(0)) <= 1e-9);
+  const EvoTrajectory fitted = read_like_evo(out, bireg::io::Format::euroc);
+  REQUIRE(fitted.stamps.size() == 5);
+  for (int i = 0; i < 5; ++i) {
+    REQUIRE(fitted.stamps[static_cast<std::size_t>(i)] ==
+            std::to_string(1700000000000000000LL + i));
+    REQUIRE(std::abs(fitted.poses[static_cast<std::size_t>(i)](0, 3) - 0.5 * i) <= 1e-9);
+  }
+}
+
+TEST_CASE("bireg_fit: output in every format follows evo's conventions, timestamps exact",
+          "[tool]") {
+  using bireg::io::Format;
+  using G = bireg::SE3<double>;
+  const Sample sample = make_sample(12);
+  const std::string input = scratch("evo_in.tum");
+  write_text(input, write_sample(sample, Format::tum));
+  for (Format format : {Format::tum, Format::euroc, Format::kitti, Format::matrix}) {
+    CAPTURE(bireg::io::to_string(format));
+    const std::string out = scratch(std::string("evo_out.") + bireg::io::to_string(format));
+    const Run run =
+        run_tool("--group SE3 --output-trajectory " + quoted(out) + " --output-format " +
+                 bireg::io::to_string(format) + " " + quoted(input));
+    CAPTURE(run.err);
+    REQUIRE(run.exit_code == 0);
+    const G::Element g0 = element_of<G>(json_numbers(run.out, "g0"));
+    const G::Element g1 = element_of<G>(json_numbers(run.out, "g1"));
+    const double span = 0.110507;  // 1700000000.110507 - 1700000000
+    const bireg::Geodesic<G> geodesic(g0, g1, 0.0, span);
+    if (format == Format::matrix) {
+      // Read back with the library's reader instead (evo has no matrix format).
+      const auto back = read_file<G>(out, Format::matrix);
+      REQUIRE(back.timestamps.size() == 12);
+      for (std::size_t i = 0; i < 12; ++i)
+        REQUIRE(back.timestamps[i].text == sample.seconds[i]);
+      continue;
+    }
+    const EvoTrajectory fitted = read_like_evo(out, format);
+    REQUIRE(fitted.poses.size() == 12);
+    const auto input_trajectory = read_file<G>(input, Format::tum);
+    for (std::size_t i = 0; i < 12; ++i) {
+      REQUIRE(bireg_test::relative_error(fitted.poses[i],
+                                         geodesic(input_trajectory.covariates[i])) <= 1e-12);
+      if (format == Format::tum) REQUIRE(fitted.stamps[i] == sample.seconds[i]);
+      if (format == Format::euroc) REQUIRE(fitted.stamps[i] == sample.nanoseconds[i]);
+    }
+  }
+}
+
+TEST_CASE("bireg_fit: hostile input in every new format, one line naming file and line", "[tool]") {
+  struct Case {
+    std::string name, args, text, expected;
+  };
+  const std::string tum_ok = "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n";
+  const std::string euroc_head = "#timestamp [ns],x,y,z,qw,qx,qy,qz\n";
+  const std::string euroc_ok = "0,0,0,0,1,0,0,0\n1000000000,1,0,0,1,0,0,0\n";
+  const std::string kitti_ok = "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n";
+  const std::string hostile = "\x1b[31m" + std::string(5000, 'x');
+  const std::vector<Case> cases = {
+      // tum
+      {"t_truncated.tum", "--format tum", tum_ok + "2 1 0 0 0 0 0\n", ":3: expected 8 numbers"},
+      {"t_text.tum", "--format tum", tum_ok + "2 1 0 abc 0 0 0 1\n", ":3: not a number: 'abc'"},
+      {"t_nan.tum", "--format tum", tum_ok + "2 nan 0 0 0 0 0 1\n", ":3: not a finite number"},
+      {"t_huge.tum", "--format tum", "1e400 0 0 0 0 0 0 1\n" + tum_ok,
+       ":1: number out of range: '1e400'"},
+      {"t_extra.tum", "--format tum", tum_ok + "2 1 0 0 0 0 0 1 7\n",
+       ":3: expected 8 numbers (timestamp tx ty tz qx qy qz qw), found 9"},
+      {"t_empty.tum", "--format tum", "# nothing\n", "t_empty.tum: no observations"},
+      {"t_one.tum", "--format tum", "0 0 0 0 0 0 0 1\n", "need at least 2 observations, got 1"},
+      {"t_equal.tum", "--format tum", "5 0 0 0 0 0 0 1\n5.0 1 0 0 0 0 0 1\n",
+       "t_equal.tum: all covariates are equal"},
+      {"t_escape.tum", "--format tum", "0 0 0 " + hostile + " 0 0 0 1\n",
+       ":1: not a number: '\\x1b[31mxxx"},
+      // euroc
+      {"e_truncated.csv", "--format euroc", euroc_head + euroc_ok + "2000000000,1,0,0,1,0,0\n",
+       ":4: expected at least 8 numbers"},
+      {"e_text.csv", "--format euroc", euroc_head + euroc_ok + "2000000000,1,0,0,1,0,zero,0\n",
+       ":4: not a number: 'zero'"},
+      {"e_nan.csv", "--format euroc", euroc_head + "0,0,0,0,NaN,0,0,0\n" + euroc_ok,
+       ":2: not a finite number: 'NaN'"},
+      {"e_huge.csv", "--format euroc", euroc_head + euroc_ok + "2000000000,1e400,0,0,1,0,0,0\n",
+       ":4: number out of range: '1e400'"},
+      {"e_empty.csv", "--format euroc", euroc_head, "e_empty.csv: no observations"},
+      {"e_one.csv", "--format euroc", euroc_head + "0,0,0,0,1,0,0,0\n",
+       "need at least 2 observations, got 1"},
+      {"e_equal.csv", "--format euroc", euroc_head + "7,0,0,0,1,0,0,0\n7,1,0,0,1,0,0,0\n",
+       "e_equal.csv: all covariates are equal"},
+      {"e_quaternion.csv", "--format euroc", euroc_head + euroc_ok + "3,0,0,0,0.5,0,0,0\n",
+       ":4: quaternion norm 0.5 is far from 1"},
+      // kitti
+      {"k_truncated.txt", "--format kitti", kitti_ok + "1 0 0 1 0 1 0 0 0 0 1\n",
+       ":3: expected 12 numbers (a 3x4 pose, row-major), found 11"},
+      {"k_extra.txt", "--format kitti", kitti_ok + "1 0 0 1 0 1 0 0 0 0 1 0 1\n",
+       ":3: expected 12 numbers (a 3x4 pose, row-major), found 13"},
+      {"k_text.txt", "--format kitti", kitti_ok + "1 0 0 1 0 1 0 0 0 0 1 O\n",
+       ":3: not a number: 'O'"},
+      {"k_nan.txt", "--format kitti", kitti_ok + "1 0 0 1 0 1 0 0 0 0 1 -nan\n",
+       ":3: not a finite number: '-nan'"},
+      {"k_huge.txt", "--format kitti", kitti_ok + "1 0 0 1e400 0 1 0 0 0 0 1 0\n",
+       ":3: number out of range: '1e400'"},
+      {"k_empty.txt", "--format kitti", "\n\n", "k_empty.txt: no observations"},
+      {"k_one.txt", "--format kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n",
+       "need at least 2 observations, got 1"},
+      {"k_rotation.txt", "--format kitti", kitti_ok + "1 0 0 1 0 2 0 0 0 0 1 0\n",
+       ":3: matrix is not an element of SE3"},
+      // matrix and tum column counts: extra columns are errors
+      {"m_extra.csv", "--format matrix",
+       "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n1, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0\n",
+       ":2: expected 10 numbers, found 11"},
+      {"m_extra_detected.csv", "",
+       "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n1, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0\n",
+       ":2: expected 10 numbers, found 11"},
+      // detection
+      {"d_ambiguous.csv", "", "#timestamp\n0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n",
+       ":2: ambiguous format: the line reads as matrix or euroc"},
+      {"d_none.txt", "", "0 1 2 3 4\n", ":1: no format fits this line"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const std::string file = scratch(c.name);
+    write_text(file, c.text);
+    const std::string group = c.name[0] == 'm' || c.name[0] == 'd' ? "SO3" : "SE3";
+    const Run run = run_tool("--group " + group + " " + c.args + " " + quoted(file));
+    CAPTURE(run.err);
+    REQUIRE(run.exit_code == 2);
+    REQUIRE(run.out.empty());
+    REQUIRE(run.err.rfind("bireg_fit: " + file, 0) == 0);
+    REQUIRE(run.err.find(c.expected) != std::string::npos);
+    // One line, bounded, printable.
+    REQUIRE(run.err.find('\n') == run.err.size() - 1);
+    REQUIRE(run.err.size() < 400);
+    for (std::size_t i = 0; i + 1 < run.err.size(); ++i)
+      REQUIRE((run.err[i] >= 0x20 && run.err[i] < 0x7f));
+  }
+
+  // KITTI times: equal times, and a count that does not match the poses.
+  const std::string poses = scratch("k_poses.txt"), times = scratch("k_times.txt");
+  write_text(poses, kitti_ok);
+  write_text(times, "0.5\n0.5\n");
+  Run run = run_tool("--group SE3 --format kitti --times " + quoted(times) + " " + quoted(poses));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find("all covariates are equal") != std::string::npos);
+  write_text(times, "0\n1\n2\n");
+  run = run_tool("--group SE3 --times " + quoted(times) + " " + quoted(poses));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find("3 times for 2 poses") != std::string::npos);
+  write_text(times, "0\nx\n");
+  run = run_tool("--group SE3 --times " + quoted(times) + " " + quoted(poses));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find(times + ":2: not a number: 'x'") != std::string::npos);
+}
+
+TEST_CASE("bireg_fit: --project re-orthonormalises and reports the correction", "[tool]") {
+  const std::string file = scratch("project.tum"), zero = scratch("project_zero.tum");
+  write_text(file, "0 0 0 0 0 0 0 1.02\n1 1 0 0 0 0 0.1 0.995\n2 2 0 0 0 0 0.2 0.98\n");
+  Run run = run_tool("--group SE3 " + quoted(file));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find(":1: quaternion norm 1.02 is far from 1") != std::string::npos);
+  run = run_tool("--group SE3 --project " + quoted(file));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(std::abs(json_numbers(run.out, "projection_correction").at(0) - 0.02) < 1e-12);
+  REQUIRE_FALSE(json_has_non_finite(run.out));
+  write_text(zero, "0 0 0 0 0 0 0 0\n1 1 0 0 0 0 0 1\n");
+  run = run_tool("--group SE3 --project " + quoted(zero));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find(":1: quaternion norm 0") != std::string::npos);
+}
+
+TEST_CASE("bireg_fit: directories, binary input, long lines and write errors", "[tool]") {
+  Run run = run_tool("--group SO3 " + quoted(work_dir().string()));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find("is a directory") != std::string::npos);
+
+  // /dev/zero on standard input: refused at once, memory bounded by the
+  // first block.
+  run = run_tool("--group SO3 - < /dev/zero");
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find("<stdin>:1: binary input") != std::string::npos);
+
+  const std::string long_line = scratch("long.csv");
+  write_text(long_line, "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n" + std::string(2 << 20, '1') + "\n");
+  run = run_tool("--group SO3 " + quoted(long_line));
+  REQUIRE(run.exit_code == 2);
+  REQUIRE(run.err.find(":2: line longer than 1048576 bytes") != std::string::npos);
+  REQUIRE(run.err.size() < 400);
+
+  if (fs::exists("/dev/full")) {
+    run = run_tool("--group SE3 --output-trajectory /dev/full \"" + data("se3_small.tum") + "\"");
+    REQUIRE(run.exit_code == 4);
+    REQUIRE(run.err.find("/dev/full: write error") != std::string::npos);
+    const std::string command = std::string("\"") + BIREG_FIT_EXECUTABLE + "\" --group SE3 \"" +
+                                data("se3_small.tum") + "\" > /dev/full 2> " +
+                                quoted(scratch("full_err.txt"));
+    const int status = std::system(command.c_str());
+    REQUIRE(WIFEXITED(status));
+    REQUIRE(WEXITSTATUS(status) == 4);
+    REQUIRE(slurp(scratch("full_err.txt")).find("<stdout>: write error") != std::string::npos);
   }
 }

@@ -11,8 +11,8 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 #ifdef EIGEN_MATRIX_FUNCTIONS
 constexpr bool kMatrixFunctionsIncluded = true;

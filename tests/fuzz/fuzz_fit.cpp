@@ -1,10 +1,17 @@
-// libFuzzer target: the trajectory parser and fit() on whatever it accepts.
+// libFuzzer target: the io/ readers and writers, and fit() on whatever the
+// readers accept.
 //
 // The first byte of the input selects the group (bits 0, 1, 4: SO2, SO3,
-// SE2, SE3, Sim3, SL3, GLp3, Heisenberg), the format (bit 2) and the solver
-// (bit 3); the rest is the file's text. Properties checked (abort = finding):
-//   * the parser never crashes and either reports an error with a line
-//     number inside the text or returns observations in the group;
+// SE2, SE3, Sim3, SL3, GLp3, Heisenberg), the format (bits 2 and 5: matrix,
+// tum, euroc, kitti), the solver (bit 3), --project (bit 6) and detection of
+// the format from the content (bit 7: the format bits are then ignored); the
+// rest is the file's text. Properties checked (abort = finding):
+//   * the readers (trajectories and KITTI times) never crash and either
+//     report an error with a bounded, printable message and a line number
+//     inside the text, or return observations in the group with finite
+//     covariates;
+//   * what they accept, written back in the format read, reads again to the
+//     same number of observations with the same timestamps;
 //   * fit() on parsed input never crashes, never returns NaN or infinity
 //     in its endpoints or diagnostics, and reports invalid input only with
 //     a message.
@@ -19,6 +26,7 @@
 #include <cstdlib>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
@@ -26,8 +34,10 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
+#include "bireg/io/line_reader.hpp"
+#include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 namespace {
 
@@ -35,18 +45,55 @@ void require(bool condition) {
   if (!condition) std::abort();
 }
 
+std::uint64_t count_lines(const std::string& text) {
+  std::uint64_t lines = 1;
+  for (char c : text)
+    lines += c == '\n';
+  return lines;
+}
+
+void require_message(const bireg::io::ParseError& error, const std::string& text) {
+  require(!error.message.empty());
+  require(error.message.size() < 400);
+  for (char c : error.message)
+    require(c >= 0x20 && c < 0x7f);
+  require(error.line <= count_lines(text));
+}
+
 template <class G>
-void exercise(const std::string& text, bireg::tools::Format format, bireg::Solver solver) {
-  std::istringstream in(text);
-  bireg::tools::Trajectory<G> trajectory;
-  const auto error = bireg::tools::read_trajectory<G>(in, format, trajectory);
+void exercise(const std::string& text, const bireg::io::ReadOptions& read_options,
+              bireg::Solver solver) {
+  bireg::io::MemorySource source(text);
+  bireg::io::Trajectory<G> trajectory;
+  const auto error = bireg::io::read_trajectory<G>(source, read_options, trajectory);
   if (error) {
-    require(!error->message.empty());
-    require(error->line >= 0);
+    require_message(*error, text);
     return;
   }
+  require(!trajectory.observations.empty());
+  require(trajectory.covariates.size() == trajectory.observations.size());
+  require(trajectory.timestamps.size() == trajectory.observations.size());
   for (const auto& g : trajectory.observations)
     require(G::is_element(g, 1e-6));
+  for (double c : trajectory.covariates)
+    require(std::isfinite(c) && c >= 0);
+  require(std::isfinite(trajectory.projection_correction));
+
+  // Written back in the format read, the text reads again.
+  const std::string written = bireg::io::format_trajectory<G>(
+      trajectory.format, trajectory.format, trajectory.timestamps, trajectory.observations);
+  bireg::io::ReadOptions again;
+  again.format = trajectory.format;
+  if (trajectory.format == bireg::io::Format::kitti) again.times = &trajectory.timestamps;
+  bireg::io::MemorySource written_source(written);
+  bireg::io::Trajectory<G> reread;
+  require(!bireg::io::read_trajectory<G>(written_source, again, reread));
+  require(reread.observations.size() == trajectory.observations.size());
+  for (std::size_t i = 0; i < reread.timestamps.size(); ++i) {
+    require(reread.timestamps[i].text == trajectory.timestamps[i].text);
+    require(reread.covariates[i] == trajectory.covariates[i]);
+  }
+
   typename bireg::GeodesicRegression<G>::Options options;
   options.solver = solver;
   options.max_iterations = 50;
@@ -72,32 +119,44 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const std::uint8_t selector = data[0];
   const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
-  const auto format = (selector & 4) ? bireg::tools::Format::tum : bireg::tools::Format::matrix;
+  using bireg::io::Format;
+  static constexpr Format kFormats[] = {Format::matrix, Format::tum, Format::euroc, Format::kitti};
+  bireg::io::ReadOptions options;
+  if (!(selector & 128)) options.format = kFormats[((selector >> 2) & 1) | ((selector >> 4) & 2)];
+  options.project = (selector & 64) != 0;
   const auto solver = (selector & 8) ? bireg::Solver::paper : bireg::Solver::gauss_newton;
+
+  // The KITTI times reader sees the same text.
+  {
+    bireg::io::MemorySource source(text);
+    std::vector<bireg::io::Timestamp> times;
+    if (const auto error = bireg::io::read_times(source, times)) require_message(*error, text);
+  }
+
   switch ((selector & 3) | ((selector >> 2) & 4)) {  // bits 0, 1 and 4
     case 0:
-      exercise<bireg::SO2<double>>(text, format, solver);
+      exercise<bireg::SO2<double>>(text, options, solver);
       break;
     case 1:
-      exercise<bireg::SO3<double>>(text, format, solver);
+      exercise<bireg::SO3<double>>(text, options, solver);
       break;
     case 2:
-      exercise<bireg::SE2<double>>(text, format, solver);
+      exercise<bireg::SE2<double>>(text, options, solver);
       break;
     case 3:
-      exercise<bireg::SE3<double>>(text, format, solver);
+      exercise<bireg::SE3<double>>(text, options, solver);
       break;
     case 4:
-      exercise<bireg::Sim3<double>>(text, format, solver);
+      exercise<bireg::Sim3<double>>(text, options, solver);
       break;
     case 5:
-      exercise<bireg::SL3<double>>(text, format, solver);
+      exercise<bireg::SL3<double>>(text, options, solver);
       break;
     case 6:
-      exercise<bireg::GLp<3, double>>(text, format, solver);
+      exercise<bireg::GLp<3, double>>(text, options, solver);
       break;
     default:
-      exercise<bireg::Heisenberg<double>>(text, format, solver);
+      exercise<bireg::Heisenberg<double>>(text, options, solver);
       break;
   }
   return 0;

@@ -1,23 +1,28 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
-//   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum]
+//   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]
+//             [--times FILE] [--project]
 //             [--method exact|series|series_adaptive] [--order M]
 //             [--solver paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
-//             [--output-trajectory FILE] FILE|-
+//             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]] FILE|-
 //
+// The formats, their detection when --format is omitted, --times and
+// --project are described in include/bireg/io/formats.hpp and README.md.
 // Sim3 (4x4 [s R t; 0 1]), SL3 and GLp3 (3x3) read the matrix format only.
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
 //
 // Prints one JSON object on stdout. Exit codes: 0 converged, 2 invalid input
 // or usage (one line on stderr naming file, line and problem), 3 the fit did
-// not converge (the JSON is still printed, with its status).
+// not converge (the JSON is still printed, with its status), 4 the output
+// could not be written (disk full, closed pipe, ...).
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <iostream>
+#include <cstring>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,24 +33,31 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
+#include "bireg/io/line_reader.hpp"
+#include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/tools/trajectory_io.hpp"
 
 namespace {
 
 constexpr int kExitInvalid = 2;
 constexpr int kExitNotConverged = 3;
+constexpr int kExitWriteError = 4;
 
 constexpr const char* kUsage =
-    "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum]\n"
+    "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]\n"
+    "                 [--times FILE] [--project]\n"
     "                 [--method exact|series|series_adaptive] [--order M]\n"
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
-    "                 [--output-trajectory FILE] FILE|-\n";
+    "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
+    "                 FILE|-\n";
 
 struct Command {
   std::string group;
-  bireg::tools::Format format = bireg::tools::Format::matrix;
+  std::optional<bireg::io::Format> format;  // empty: detect
+  std::string times;
+  bool project = false;
   bireg::Method method = bireg::Method::exact;
   int order = 0;
   bireg::Solver solver = bireg::Solver::gauss_newton;
@@ -53,6 +65,7 @@ struct Command {
   std::optional<double> tolerance;
   int max_iterations = 1000;
   std::string output_trajectory;
+  std::optional<bireg::io::Format> output_format;  // empty: the input's
   std::string input;
 };
 
@@ -88,18 +101,22 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       command.input = arg;
       continue;
     }
+    if (arg == "--project") {
+      command.project = true;
+      continue;
+    }
     const std::optional<std::string> v = value();
     if (!v) return "option " + arg + " needs a value";
     if (arg == "--group") {
       command.group = *v;
-    } else if (arg == "--format") {
-      if (*v == "matrix") {
-        command.format = bireg::tools::Format::matrix;
-      } else if (*v == "tum") {
-        command.format = bireg::tools::Format::tum;
-      } else {
-        return "unknown format '" + *v + "' (matrix or tum)";
+    } else if (arg == "--format" || arg == "--output-format") {
+      const auto format = bireg::io::format_from_string(*v);
+      if (!format) {
+        return "unknown format " + bireg::io::quote_excerpt(*v) + " (matrix, tum, euroc or kitti)";
       }
+      (arg == "--format" ? command.format : command.output_format) = format;
+    } else if (arg == "--times") {
+      command.times = *v;
     } else if (arg == "--method") {
       bool known = false;
       for (bireg::Method method :
@@ -147,6 +164,12 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     }
   }
   if (command.group.empty()) return "--group is required";
+  if (command.output_format && command.output_trajectory.empty()) {
+    return "--output-format goes with --output-trajectory FILE";
+  }
+  if (!command.times.empty() && command.format && *command.format != bireg::io::Format::kitti) {
+    return "--times goes with the kitti format";
+  }
   if (command.input.empty()) return "no input file (use - for standard input)";
   if (command.method == bireg::Method::series && !order_given)
     return "--method series needs --order M";
@@ -156,25 +179,63 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   return std::nullopt;
 }
 
-std::string json_number(double x) {
-  return std::isfinite(x) ? bireg::tools::format_double(x) : std::string("null");
+using bireg::io::json_number;
+
+// Opens `path` ("-": standard input) for reading as a C stream, or says why
+// not (a directory is refused by name: reading it would fail with EISDIR).
+std::FILE* open_input(const std::string& path, const std::string& name, std::string& problem) {
+  if (path == "-") return stdin;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    problem = name + ": is a directory, not a file";
+    return nullptr;
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) problem = name + ": cannot open file (" + std::strerror(errno) + ")";
+  return file;
+}
+
+std::string where(const std::string& name, std::uint64_t line) {
+  return line > 0 ? name + ":" + std::to_string(line) : name;
 }
 
 template <class G>
 int run(const Command& command) {
   using Regression = bireg::GeodesicRegression<G>;
+  namespace io = bireg::io;
   const std::string name = command.input == "-" ? "<stdin>" : command.input;
-  std::ifstream file;
-  if (command.input != "-") {
-    file.open(command.input);
-    if (!file) return fail(name + ": cannot open file");
+  if (command.output_format && !io::supports<G>(*command.output_format)) {
+    return fail(std::string("the ") + io::to_string(*command.output_format) +
+                " format holds SE3 or SO3 poses, not " + G::name);
   }
-  std::istream& in = command.input == "-" ? std::cin : file;
 
-  bireg::tools::Trajectory<G> trajectory;
-  if (const auto error = bireg::tools::read_trajectory<G>(in, command.format, trajectory)) {
-    const std::string where = error->line > 0 ? name + ":" + std::to_string(error->line) : name;
-    return fail(where + ": " + error->message);
+  io::ReadOptions read_options;
+  read_options.format = command.format;
+  read_options.project = command.project;
+  std::vector<io::Timestamp> times;
+  std::string problem;
+  if (!command.times.empty()) {
+    std::FILE* file = open_input(command.times, command.times, problem);
+    if (!file) return fail(problem);
+    io::FileSource source(file);
+    const auto error = io::read_times(source, times);
+    if (file != stdin) std::fclose(file);
+    if (error) return fail(where(command.times, error->line) + ": " + error->message);
+    read_options.times = &times;
+  }
+
+  io::Trajectory<G> trajectory;
+  {
+    std::FILE* file = open_input(command.input, name, problem);
+    if (!file) return fail(problem);
+    io::FileSource source(file);
+    const auto error = io::read_trajectory<G>(source, read_options, trajectory);
+    if (file != stdin) std::fclose(file);
+    if (error) return fail(where(name, error->line) + ": " + error->message);
+  }
+  if (!command.times.empty() && trajectory.format != io::Format::kitti) {
+    return fail(name + ": --times goes with the kitti format, and the input reads as " +
+                io::to_string(trajectory.format));
   }
 
   typename Regression::Options options;
@@ -186,42 +247,66 @@ int run(const Command& command) {
   options.max_iterations = command.max_iterations;
   const auto result = Regression(options).fit(trajectory.observations, trajectory.covariates);
   if (result.status == bireg::Status::invalid_input) {
-    const std::string where =
-        result.bad_index >= 0
-            ? name + ":" +
-                  std::to_string(trajectory.lines[static_cast<std::size_t>(result.bad_index)])
-            : name;
-    return fail(where + ": " + result.message);
+    const std::uint64_t line =
+        result.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(result.bad_index)] : 0;
+    return fail(where(name, line) + ": " + result.message);
+  }
+
+  if (!command.output_trajectory.empty()) {
+    const io::Format format = command.output_format.value_or(trajectory.format);
+    std::vector<typename G::Element> fitted;
+    fitted.reserve(trajectory.covariates.size());
+    for (double t : trajectory.covariates)
+      fitted.push_back((*result.geodesic)(t));
+    std::FILE* out = std::fopen(command.output_trajectory.c_str(), "wb");
+    if (!out) {
+      std::fprintf(stderr, "bireg_fit: %s: cannot write file (%s)\n",
+                   command.output_trajectory.c_str(), std::strerror(errno));
+      return kExitWriteError;
+    }
+    auto error =
+        io::write_trajectory<G>(out, format, trajectory.format, trajectory.timestamps, fitted);
+    errno = 0;
+    if (std::fclose(out) != 0 && !error) {
+      error = std::string("write error: ") + std::strerror(errno);
+    }
+    if (error) {
+      std::fprintf(stderr, "bireg_fit: %s: %s\n", command.output_trajectory.c_str(),
+                   error->c_str());
+      return kExitWriteError;
+    }
   }
 
   const auto& d = result.diagnostics;
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
+  const std::string projection = command.project ? ", \"projection_correction\": " +
+                                                       json_number(trajectory.projection_correction)
+                                                 : std::string();
   std::printf(
-      "{\"group\": \"%s\", \"n\": %zu,\n \"g0\": %s,\n \"g1\": %s,\n \"t_min\": %s, \"t_max\": "
-      "%s,\n"
+      "{\"group\": \"%s\", \"format\": \"%s\", \"n\": %zu%s,\n \"g0\": %s,\n \"g1\": %s,\n"
+      " \"t_min\": %s, \"t_max\": %s,\n"
       " \"status\": \"%s\", \"iterations\": %d, \"final_step_norm\": %s,\n"
       " \"diagnostics\": {\"mu_min\": %s, \"mu_max\": %s, \"step_size\": %s, "
       "\"contraction_factor\": %s, \"method\": \"%s\", \"series_order\": %d, \"solver\": \"%s\", "
       "\"backtracks\": %d, "
       "\"force_norm\": %s, "
       "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
-      G::name, trajectory.observations.size(),
-      bireg::tools::json_matrix(result.geodesic->start()).c_str(),
-      bireg::tools::json_matrix(result.geodesic->end()).c_str(),
-      json_number(result.geodesic->t_min()).c_str(), json_number(result.geodesic->t_max()).c_str(),
+      G::name, io::to_string(trajectory.format), trajectory.observations.size(), projection.c_str(),
+      io::json_matrix(result.geodesic->start()).c_str(),
+      io::json_matrix(result.geodesic->end()).c_str(),
+      io::render_timestamp(trajectory.origin, io::TimeUnit::seconds).c_str(),
+      io::render_timestamp(trajectory.last, io::TimeUnit::seconds).c_str(),
       bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
       json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
       json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(),
       bireg::to_string(command.method), d.series_order, bireg::to_string(command.solver),
       d.backtracks, json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
       json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
-
-  if (!command.output_trajectory.empty()) {
-    std::ofstream out(command.output_trajectory);
-    if (!out) return fail(command.output_trajectory + ": cannot write file");
-    for (double t : trajectory.covariates) {
-      out << bireg::tools::format_observation<G>(command.format, t, (*result.geodesic)(t)) << '\n';
-    }
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "bireg_fit: <stdout>: write error: %s\n",
+                 errno != 0 ? std::strerror(errno) : "unknown");
+    return kExitWriteError;
   }
   return result.ok() ? 0 : kExitNotConverged;
 }

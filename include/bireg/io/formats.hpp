@@ -1,0 +1,482 @@
+// bireg io: trajectory files as text, read into group elements.
+//
+// Formats (one observation per line; blank lines and lines whose first
+// non-blank character is '#' are skipped; numbers are separated by commas
+// and/or white space):
+//   matrix  t, m00, m01, ..., m(n-1)(n-1): the covariate then the n x n
+//           matrix row-major, any group.
+//   tum     timestamp tx ty tz qx qy qz qw (seconds; quaternion w last), for
+//           SE3, or SO3 using the rotation.
+//   euroc   timestamp p_x p_y p_z q_w q_x q_y q_z [more columns] (comma-
+//           separated, timestamp in integer nanoseconds, quaternion w first;
+//           columns after the eighth, such as EuRoC ground truth's
+//           velocities and biases, are ignored unread), for SE3 or SO3.
+//   kitti   r00 r01 r02 tx r10 r11 r12 ty r20 r21 r22 tz (the 3x4 pose
+//           row-major, no timestamp; times come from a separate file, one
+//           per line, or are the frame indices 0, 1, 2, ...), for SE3 or SO3.
+// Quaternions are normalised; one whose norm is off 1 by more than 1e-3 is an
+// error, and a matrix farther than 1e-6 from the group is an error, unless
+// ReadOptions::project is set (SO2, SO3, SE2, SE3): then quaternions are
+// normalised and rotation blocks replaced by their nearest rotation (SVD),
+// the largest change reported; a quaternion of norm below 1e-6 and a block
+// whose nearest rotation is not unique (rank < 2) are errors even then.
+//
+// Detection (ReadOptions::format empty): groups other than SO3 and SE3 read
+// the matrix format. For SO3 and SE3 the first data line decides: a format
+// is a candidate when the line has its shape (matrix: 1 + n^2 numbers; tum:
+// 8 numbers, no comma; kitti: 12 numbers, no comma; euroc: 8 numbers or
+// more, comma-separated, an integer first column, and a '#' header line
+// containing "timestamp" before the data). Several candidates are narrowed
+// to those the line is a valid element in; if that does not leave exactly
+// one, the input is ambiguous (an error naming the candidates); no
+// candidate is an error naming the line.
+//
+// Timestamps are kept as text and exactly (see numbers.hpp); the covariate
+// of an observation is its time in seconds (or the matrix covariate's own
+// unit) after the earliest timestamp, computed exactly then rounded once.
+// Never throws on bad input: every problem is a ParseError naming the line.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <istream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SVD>
+
+#include "bireg/groups/se2.hpp"
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/so2.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/io/line_reader.hpp"
+#include "bireg/io/numbers.hpp"
+
+namespace bireg {
+namespace io {
+
+enum class Format { matrix, tum, euroc, kitti };
+
+inline const char* to_string(Format format) {
+  switch (format) {
+    case Format::matrix:
+      return "matrix";
+    case Format::tum:
+      return "tum";
+    case Format::euroc:
+      return "euroc";
+    case Format::kitti:
+      return "kitti";
+  }
+  return "?";
+}
+
+inline std::optional<Format> format_from_string(std::string_view name) {
+  for (Format f : {Format::matrix, Format::tum, Format::euroc, Format::kitti}) {
+    if (name == to_string(f)) return f;
+  }
+  return std::nullopt;
+}
+
+inline TimeUnit time_unit(Format format) {
+  return format == Format::euroc ? TimeUnit::nanoseconds : TimeUnit::seconds;
+}
+
+// Whether G's elements can be read from (and written to) `format`.
+template <class G>
+constexpr bool is_pose_group() {
+  return std::is_same_v<G, SE3<double>> || std::is_same_v<G, SO3<double>>;
+}
+template <class G>
+constexpr bool supports(Format format) {
+  return format == Format::matrix || is_pose_group<G>();
+}
+// Whether ReadOptions::project applies to G.
+template <class G>
+constexpr bool can_project() {
+  return is_pose_group<G>() || std::is_same_v<G, SE2<double>> || std::is_same_v<G, SO2<double>>;
+}
+
+struct ReadOptions {
+  std::optional<Format> format;  // empty: detect from the content
+  bool project = false;
+  double element_tolerance = 1e-6;
+  // kitti: the timestamp of every pose, in order; null: frame indices.
+  const std::vector<Timestamp>* times = nullptr;
+};
+
+template <class G>
+struct Trajectory {
+  std::vector<typename G::Element> observations;
+  std::vector<double> covariates;  // seconds after `origin`
+  std::vector<Timestamp> timestamps;
+  std::vector<std::uint64_t> lines;  // source line of each observation
+  Format format = Format::matrix;    // as read (detected or given)
+  Timestamp origin, last;            // the earliest and the latest timestamp
+  double projection_correction = 0;  // largest change made by projection
+};
+
+// Side of the square matrix of G's elements in the matrix format.
+template <class G>
+constexpr int matrix_side() {
+  return static_cast<int>(G::Element::RowsAtCompileTime);
+}
+
+// Rotation matrix of a unit quaternion (w, x, y, z).
+inline Eigen::Matrix3d rotation_of_quaternion(double w, double x, double y, double z) {
+  Eigen::Matrix3d r;
+  r << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),  //
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),   //
+      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
+  return r;
+}
+
+// The rotation nearest to `m` in the Frobenius norm (polar decomposition by
+// SVD), or the reason it is not unique: rank < 2, or a reflection whose two
+// smallest singular values are equal.
+template <int N>
+std::optional<std::string> nearest_rotation(Eigen::Matrix<double, N, N>& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix<double, N, N>> svd(
+      m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const auto& s = svd.singularValues();
+  const double tolerance = 1e-9 * s[0];
+  if (!(s[0] > 0) || (N >= 3 && !(s[N - 2] > tolerance))) {
+    return std::string("rotation block has rank < 2: its nearest rotation is not defined");
+  }
+  Eigen::Matrix<double, N, N> u = svd.matrixU();
+  const Eigen::Matrix<double, N, N>& v = svd.matrixV();
+  if ((u * v.transpose()).determinant() < 0) {
+    if (!(s[N - 2] - s[N - 1] > tolerance)) {
+      return std::string("rotation block is a reflection without a unique nearest rotation");
+    }
+    u.col(N - 1) *= -1;
+  }
+  m = u * v.transpose();
+  return std::nullopt;
+}
+
+namespace detail {
+
+// One data line as an element of G (and the line's timestamp token), or an
+// error message. `correction` grows to the largest projection change.
+template <class G>
+std::optional<std::string> parse_line(Format format, const std::vector<std::string_view>& tokens,
+                                      const ReadOptions& options, typename G::Element& g,
+                                      std::string_view& time_token, double& correction) {
+  constexpr int n = matrix_side<G>();
+  constexpr bool is_se3 = std::is_same_v<G, SE3<double>>;
+  constexpr bool is_so3 = std::is_same_v<G, SO3<double>>;
+  double x[17];
+  const auto parse = [&](std::size_t first, std::size_t count) -> std::optional<std::string> {
+    for (std::size_t i = 0; i < count; ++i) {
+      if (auto problem = parse_number(tokens[first + i], x[first + i])) return problem;
+    }
+    return std::nullopt;
+  };
+  const auto found = [&](const std::string& expected) {
+    return "expected " + expected + ", found " + std::to_string(tokens.size());
+  };
+  g = G::identity();
+  time_token = {};
+  Eigen::Matrix3d r;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  bool from_rotation = false;  // r (and p) hold the pose
+  if (format == Format::matrix) {
+    const std::size_t expected = 1 + n * n;
+    if (tokens.size() != expected) return found(std::to_string(expected) + " numbers");
+    double value = 0;
+    if (auto problem = parse_number(tokens[0], value)) return problem;
+    time_token = tokens[0];
+    for (int row = 0; row < n; ++row) {
+      for (int col = 0; col < n; ++col) {
+        const std::size_t k = 1 + static_cast<std::size_t>(row * n + col);
+        if (auto problem = parse_number(tokens[k], value)) return problem;
+        g(row, col) = value;
+      }
+    }
+    if constexpr (can_project<G>()) {
+      if (options.project) {
+        constexpr int k = is_se3 || std::is_same_v<G, SE2<double>> ? n - 1 : n;
+        typename G::Element projected = g;
+        Eigen::Matrix<double, k, k> block = g.template topLeftCorner<k, k>();
+        if (auto problem = nearest_rotation<k>(block)) return problem;
+        projected.template topLeftCorner<k, k>() = block;
+        if (k < n) {
+          projected.row(n - 1).setZero();
+          projected(n - 1, n - 1) = 1;
+        }
+        const double change = (projected - g).norm();
+        if (change > correction) correction = change;
+        g = projected;
+      }
+    }
+  } else if (format == Format::kitti) {
+    if (tokens.size() != 12) return found("12 numbers (a 3x4 pose, row-major)");
+    if (auto problem = parse(0, 12)) return problem;
+    r << x[0], x[1], x[2], x[4], x[5], x[6], x[8], x[9], x[10];
+    p << x[3], x[7], x[11];
+    if (options.project) {
+      Eigen::Matrix3d projected = r;
+      if (auto problem = nearest_rotation<3>(projected)) return problem;
+      const double change = (projected - r).norm();
+      if (change > correction) correction = change;
+      r = projected;
+    }
+    from_rotation = true;
+  } else {
+    // tum and euroc: a timestamp, a position and a quaternion.
+    std::size_t qw = 0, qx = 0;
+    if (format == Format::tum) {
+      if (tokens.size() != 8) return found("8 numbers (timestamp tx ty tz qx qy qz qw)");
+      qx = 4;
+      qw = 7;
+    } else {
+      if (tokens.size() < 8) {
+        return found("at least 8 numbers (timestamp p_x p_y p_z q_w q_x q_y q_z)");
+      }
+      qw = 4;
+      qx = 5;
+    }
+    double t = 0;
+    if (auto problem = parse_number(tokens[0], t)) return problem;
+    time_token = tokens[0];
+    if (auto problem = parse(1, 7)) return problem;
+    const double w = x[qw], a = x[qx], b = x[qx + 1], c = x[qx + 2];
+    const double norm = std::sqrt(w * w + a * a + b * b + c * c);
+    if (options.project) {
+      if (!(norm >= 1e-6)) {
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "quaternion norm %g is too small to normalise", norm);
+        return std::string(buffer);
+      }
+      const double change = std::abs(norm - 1);
+      if (change > correction) correction = change;
+    } else if (!(std::abs(norm - 1) <= 1e-3)) {
+      char buffer[64];
+      std::snprintf(buffer, sizeof buffer, "quaternion norm %g is far from 1", norm);
+      return std::string(buffer) + " (--project normalises it)";
+    }
+    r = rotation_of_quaternion(w / norm, a / norm, b / norm, c / norm);
+    p << x[1], x[2], x[3];
+    from_rotation = true;
+  }
+  if (from_rotation) {
+    if constexpr (is_se3) {
+      g.setIdentity();
+      g.template topLeftCorner<3, 3>() = r;
+      g.template topRightCorner<3, 1>() = p;
+    } else if constexpr (is_so3) {
+      g = r;
+    }
+  }
+  if (!G::is_element(g, options.element_tolerance)) {
+    std::string message = std::string("matrix is not an element of ") + G::name;
+    if (can_project<G>() && !options.project) message += " (--project re-orthonormalises it)";
+    return message;
+  }
+  return std::nullopt;
+}
+
+// Whether the first data line has the shape of `format` (see the rules at
+// the top of this file).
+template <class G>
+bool has_shape(Format format, const std::vector<std::string_view>& tokens, bool had_comma,
+               bool timestamp_header) {
+  constexpr std::size_t n = static_cast<std::size_t>(matrix_side<G>());
+  switch (format) {
+    case Format::matrix:
+      return tokens.size() == 1 + n * n;
+    case Format::tum:
+      return tokens.size() == 8 && !had_comma;
+    case Format::kitti:
+      return tokens.size() == 12 && !had_comma;
+    case Format::euroc: {
+      if (tokens.size() < 8 || !had_comma || !timestamp_header) return false;
+      for (char c : tokens[0])
+        if (c < '0' || c > '9') return false;
+      return true;
+    }
+  }
+  return false;
+}
+
+inline bool mentions_timestamp(std::string_view line) {
+  static constexpr std::string_view kWord = "timestamp";
+  if (line.size() < kWord.size()) return false;
+  for (std::size_t i = 0; i + kWord.size() <= line.size(); ++i) {
+    std::size_t k = 0;
+    while (k < kWord.size() && (line[i + k] | 0x20) == kWord[k])
+      ++k;
+    if (k == kWord.size()) return true;
+  }
+  return false;
+}
+
+}  // namespace detail
+
+// Reads a whole trajectory. On success the trajectory has at least one
+// observation; the caller checks whether that is enough for its purpose.
+template <class G>
+std::optional<ParseError> read_trajectory(ByteSource& source, const ReadOptions& options,
+                                          Trajectory<G>& out) {
+  out = Trajectory<G>();
+  if (options.format && !supports<G>(*options.format)) {
+    return ParseError{0, std::string("the ") + to_string(*options.format) +
+                             " format holds SE3 or SO3 poses, not " + G::name};
+  }
+  if (options.project && !can_project<G>()) {
+    return ParseError{0, std::string("--project applies to SO2, SO3, SE2 and SE3, not ") + G::name};
+  }
+  std::optional<Format> format = options.format;
+  if (!format && !is_pose_group<G>()) format = Format::matrix;
+  LineReader reader(source);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  bool timestamp_header = false;
+  typename G::Element g;
+  std::string_view time_token;
+  while (reader.next(line)) {
+    const std::uint64_t line_number = reader.line_number();
+    std::size_t first = 0;
+    while (first < line.size() && is_separator(line[first]))
+      ++first;
+    if (first == line.size()) continue;
+    if (line[first] == '#') {
+      if (out.observations.empty() && detail::mentions_timestamp(line)) timestamp_header = true;
+      continue;
+    }
+    bool had_comma = false;
+    split_tokens(line, tokens, &had_comma);
+    if (!format) {
+      // Detection on the first data line.
+      std::vector<Format> shaped, valid;
+      for (Format f : {Format::matrix, Format::tum, Format::euroc, Format::kitti}) {
+        if (detail::has_shape<G>(f, tokens, had_comma, timestamp_header)) shaped.push_back(f);
+      }
+      if (shaped.empty()) {
+        return ParseError{line_number,
+                          "no format fits this line (" + std::to_string(tokens.size()) +
+                              " numbers; matrix has " +
+                              std::to_string(1 + matrix_side<G>() * matrix_side<G>()) +
+                              ", tum 8, kitti 12, euroc 8 or more comma-separated): use --format"};
+      }
+      if (shaped.size() == 1) {
+        format = shaped.front();
+      } else {
+        ReadOptions strict = options;
+        strict.project = false;
+        double ignored = 0;
+        for (Format f : shaped) {
+          if (!detail::parse_line<G>(f, tokens, strict, g, time_token, ignored)) valid.push_back(f);
+        }
+        if (valid.size() != 1) {
+          std::string names;
+          for (Format f : shaped)
+            names += std::string(names.empty() ? "" : " or ") + to_string(f);
+          return ParseError{line_number, "ambiguous format: the line reads as " + names +
+                                             "; say which with --format"};
+        }
+        format = valid.front();
+      }
+    }
+    double correction = out.projection_correction;
+    if (auto problem = detail::parse_line<G>(*format, tokens, options, g, time_token, correction)) {
+      return ParseError{line_number, std::move(*problem)};
+    }
+    out.projection_correction = correction;
+    Timestamp stamp;
+    if (*format == Format::kitti) {
+      const std::size_t index = out.observations.size();
+      if (options.times) {
+        if (index >= options.times->size()) {
+          return ParseError{
+              line_number, "more poses than times (" + std::to_string(options.times->size()) + ")"};
+        }
+        stamp = (*options.times)[index];
+      } else {
+        stamp = frame_timestamp(index);
+      }
+    } else if (auto problem = parse_timestamp(time_token, time_unit(*format), stamp)) {
+      return ParseError{line_number, std::move(*problem)};
+    }
+    out.observations.push_back(g);
+    out.timestamps.push_back(std::move(stamp));
+    out.lines.push_back(line_number);
+  }
+  if (reader.error()) return reader.error();
+  if (out.observations.empty()) return ParseError{0, "no observations"};
+  out.format = *format;
+  if (*format == Format::kitti && options.times &&
+      options.times->size() != out.observations.size()) {
+    return ParseError{0, std::to_string(options.times->size()) + " times for " +
+                             std::to_string(out.observations.size()) + " poses"};
+  }
+  // Covariates: seconds after the earliest timestamp, exact until rounded.
+  std::size_t earliest = 0, latest = 0;
+  for (std::size_t i = 1; i < out.timestamps.size(); ++i) {
+    if (earlier(out.timestamps[i], out.timestamps[earliest])) earliest = i;
+    if (earlier(out.timestamps[latest], out.timestamps[i])) latest = i;
+  }
+  out.origin = out.timestamps[earliest];
+  out.last = out.timestamps[latest];
+  out.covariates.reserve(out.timestamps.size());
+  for (std::size_t i = 0; i < out.timestamps.size(); ++i) {
+    const double c = seconds_between(out.timestamps[i], out.origin);
+    if (!std::isfinite(c)) {
+      return ParseError{out.lines[i], "timestamp " + quote_excerpt(out.timestamps[i].text) +
+                                          " is too far from the earliest one"};
+    }
+    out.covariates.push_back(c);
+  }
+  return std::nullopt;
+}
+
+template <class G>
+std::optional<ParseError> read_trajectory(std::istream& in, const ReadOptions& options,
+                                          Trajectory<G>& out) {
+  StreamSource source(in);
+  return read_trajectory<G>(source, options, out);
+}
+
+// The reader of earlier versions: a given format, no projection.
+template <class G>
+std::optional<ParseError> read_trajectory(std::istream& in, Format format, Trajectory<G>& out,
+                                          double element_tolerance = 1e-6) {
+  ReadOptions options;
+  options.format = format;
+  options.element_tolerance = element_tolerance;
+  return read_trajectory<G>(in, options, out);
+}
+
+// A KITTI times file: one time in seconds per line (blank and '#' lines
+// skipped).
+inline std::optional<ParseError> read_times(ByteSource& source, std::vector<Timestamp>& out) {
+  out.clear();
+  LineReader reader(source);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  while (reader.next(line)) {
+    split_tokens(line, tokens);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (tokens.size() != 1) {
+      return ParseError{reader.line_number(),
+                        "expected 1 number, found " + std::to_string(tokens.size())};
+    }
+    Timestamp t;
+    if (auto problem = parse_timestamp(tokens[0], TimeUnit::seconds, t)) {
+      return ParseError{reader.line_number(), std::move(*problem)};
+    }
+    out.push_back(std::move(t));
+  }
+  if (reader.error()) return reader.error();
+  if (out.empty()) return ParseError{0, "no times"};
+  return std::nullopt;
+}
+
+}  // namespace io
+}  // namespace bireg

@@ -1,0 +1,456 @@
+// The io/ layer on its own: the line reader's bounds and errors, numbers and
+// exact timestamps, every format read, written and read again, detection,
+// projection, column counts and write errors.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <streambuf>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "bireg/groups/matrix_group.hpp"
+#include "bireg/groups/se2.hpp"
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
+#include "bireg/io/line_reader.hpp"
+#include "bireg/io/numbers.hpp"
+#include "bireg/io/writers.hpp"
+#include "catch.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using bireg::io::Format;
+using SE3 = bireg::SE3<double>;
+using SO3 = bireg::SO3<double>;
+
+std::vector<std::string> all_lines(bireg::io::ByteSource& source, std::size_t max_line,
+                                   std::optional<bireg::io::ParseError>& error,
+                                   std::size_t block = 7) {
+  bireg::io::LineReader reader(source, max_line, block);
+  std::vector<std::string> lines;
+  std::string_view line;
+  while (reader.next(line))
+    lines.emplace_back(line);
+  error = reader.error();
+  return lines;
+}
+
+template <class G>
+std::optional<bireg::io::ParseError> read_text(const std::string& text,
+                                               const bireg::io::ReadOptions& options,
+                                               bireg::io::Trajectory<G>& out) {
+  bireg::io::MemorySource source(text);
+  return bireg::io::read_trajectory<G>(source, options, out);
+}
+
+template <class G>
+bireg::io::Trajectory<G> read_ok(const std::string& text, bireg::io::ReadOptions options = {}) {
+  bireg::io::Trajectory<G> trajectory;
+  const auto error = read_text<G>(text, options, trajectory);
+  CAPTURE(text.substr(0, 300), error ? error->message : std::string());
+  REQUIRE_FALSE(error.has_value());
+  return trajectory;
+}
+
+template <class G>
+bireg::io::ParseError read_error(const std::string& text, bireg::io::ReadOptions options = {}) {
+  bireg::io::Trajectory<G> trajectory;
+  const auto error = read_text<G>(text, options, trajectory);
+  CAPTURE(text.substr(0, 300));
+  REQUIRE(error.has_value());
+  return *error;
+}
+
+// A random SE(3) trajectory with `n` poses.
+std::vector<SE3::Element> random_poses(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<SE3::Element> poses;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Matrix<double, 6, 1> x =
+        bireg_test::random_tangent<Eigen::Matrix<double, 6, 1>>(rng, 2.0);
+    poses.push_back(SE3::exp(x));
+  }
+  return poses;
+}
+
+std::vector<bireg::io::Timestamp> timestamps_of(const std::vector<std::string>& texts,
+                                                bireg::io::TimeUnit unit) {
+  std::vector<bireg::io::Timestamp> out;
+  for (const auto& text : texts) {
+    bireg::io::Timestamp t;
+    REQUIRE_FALSE(bireg::io::parse_timestamp(text, unit, t).has_value());
+    out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("line reader: ends of line, bounded length, NUL bytes, 64-bit counts", "[io]") {
+  std::optional<bireg::io::ParseError> error;
+  {
+    bireg::io::MemorySource source("a\r\nbb\n\nccc");
+    const auto lines = all_lines(source, 100, error);
+    REQUIRE_FALSE(error);
+    REQUIRE(lines == std::vector<std::string>{"a", "bb", "", "ccc"});
+  }
+  {
+    // A line of exactly the limit passes, one byte more is an error naming it.
+    const std::string ok(16, 'x');
+    const std::string text = "1\n" + ok + "\n" + ok + "y\n4\n";
+    bireg::io::MemorySource source(text);
+    const auto lines = all_lines(source, 16, error);
+    REQUIRE(lines.size() == 2);
+    REQUIRE(error);
+    REQUIRE(error->line == 3);
+    REQUIRE(error->message == "line longer than 16 bytes (the limit)");
+  }
+  {
+    // The last line, without '\n', is bounded too.
+    const std::string text = "1\n" + std::string(40, 'z');
+    bireg::io::MemorySource source(text);
+    all_lines(source, 16, error);
+    REQUIRE(error);
+    REQUIRE(error->line == 2);
+  }
+  {
+    const std::string text = std::string("1 2\n3 4\n5") + '\0' + "6\n";
+    bireg::io::MemorySource source(text);
+    const auto lines = all_lines(source, 100, error);
+    REQUIRE(lines.size() == 2);
+    REQUIRE(error);
+    REQUIRE(error->line == 3);
+    REQUIRE(error->message.find("NUL") != std::string::npos);
+  }
+  STATIC_REQUIRE(std::is_same_v<decltype(error->line), std::uint64_t>);
+  STATIC_REQUIRE(
+      std::is_same_v<
+          decltype(bireg::io::LineReader(std::declval<bireg::io::ByteSource&>()).line_number()),
+          std::uint64_t>);
+}
+
+TEST_CASE("line reader: /dev/zero fails at once on line 1 with bounded memory", "[io]") {
+  std::FILE* zero = std::fopen("/dev/zero", "rb");
+  if (!zero) {
+    WARN("no /dev/zero: skipped");
+    return;
+  }
+  bireg::io::FileSource source(zero);
+  std::optional<bireg::io::ParseError> error;
+  const auto lines = all_lines(source, bireg::io::kMaxLineLength, error, std::size_t{1} << 16);
+  std::fclose(zero);
+  REQUIRE(lines.empty());
+  REQUIRE(error);
+  REQUIRE(error->line == 1);
+  REQUIRE(error->message.find("NUL") != std::string::npos);
+}
+
+namespace {
+// A stream whose buffer fails after some bytes, as a disk read error would.
+class FailingBuffer : public std::streambuf {
+ public:
+  explicit FailingBuffer(std::string text) : text_(std::move(text)) {
+    setg(text_.data(), text_.data(), text_.data() + text_.size());
+  }
+
+ protected:
+  int_type underflow() override { throw std::runtime_error("I/O error"); }
+
+ private:
+  std::string text_;
+};
+}  // namespace
+
+TEST_CASE("a read error is an error, not the end of the input", "[io]") {
+  const std::string first = "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n";
+  FailingBuffer buffer(first);
+  std::istream in(&buffer);
+  bireg::io::Trajectory<SE3> trajectory;
+  const auto error = bireg::io::read_trajectory<SE3>(in, Format::tum, trajectory);
+  REQUIRE(error);
+  REQUIRE(error->message.find("read error") != std::string::npos);
+
+  // A directory opened as a file fails on its first read.
+  std::FILE* directory = std::fopen("/", "rb");
+  if (directory) {
+    bireg::io::FileSource source(directory);
+    bireg::io::ReadOptions options;
+    const auto e = bireg::io::read_trajectory<SE3>(source, options, trajectory);
+    std::fclose(directory);
+    REQUIRE(e);
+    REQUIRE(e->message.find("read error") != std::string::npos);
+  }
+}
+
+TEST_CASE("error excerpts are bounded and escaped", "[io]") {
+  REQUIRE(bireg::io::quote_excerpt("abc") == "'abc'");
+  const std::string hostile = "\x1b[2J\x1b]0;pwned\x07" + std::string(1000, 'A');
+  const std::string quoted = bireg::io::quote_excerpt(hostile);
+  REQUIRE(quoted.size() <= 40 * 4 + 5);
+  for (char c : quoted)
+    REQUIRE((c >= 0x20 && c < 0x7f));
+  REQUIRE(quoted.find("...") != std::string::npos);
+  const auto e = read_error<SO3>("0 1 0 0 0 1 0 0 0 " + hostile + "\n");
+  for (char c : e.message)
+    REQUIRE((c >= 0x20 && c < 0x7f));
+  REQUIRE(e.message.size() < 200);
+}
+
+TEST_CASE("numbers: from_chars fast path, strtod's syntax and messages kept", "[io]") {
+  double x = 0;
+  REQUIRE_FALSE(bireg::io::parse_number("0.1", x));
+  REQUIRE(x == 0.1);
+  REQUIRE_FALSE(bireg::io::parse_number("+2.5e-3", x));
+  REQUIRE(x == 2.5e-3);
+  REQUIRE_FALSE(bireg::io::parse_number("1e-400", x));  // underflow reads as 0
+  REQUIRE(x == 0);
+  REQUIRE(*bireg::io::parse_number("1e400", x) == "number out of range: '1e400'");
+  REQUIRE(*bireg::io::parse_number("nan", x) == "not a finite number: 'nan'");
+  REQUIRE(*bireg::io::parse_number("-inf", x) == "not a finite number: '-inf'");
+  REQUIRE(*bireg::io::parse_number("abc", x) == "not a number: 'abc'");
+  REQUIRE(*bireg::io::parse_number("1.5x", x) == "not a number: '1.5x'");
+  // Every double survives format_double and parse_number.
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 10000; ++i) {
+    double y = 0;
+    const std::uint64_t bits = rng();
+    std::memcpy(&y, &bits, sizeof y);
+    if (!std::isfinite(y)) continue;
+    double back = 0;
+    REQUIRE_FALSE(bireg::io::parse_number(bireg::io::format_double(y), back));
+    REQUIRE(back == y);
+  }
+}
+
+TEST_CASE("timestamps: exact differences at 1.7e18 ns and 1.7e9 s", "[io]") {
+  using bireg::io::TimeUnit;
+  // 1 ns apart at 1.7e18 ns: every covariate distinct, exactly 1e-9 s apart.
+  std::string text = "#timestamp [ns],x,y,z,qw,qx,qy,qz\n";
+  for (int i = 0; i < 5; ++i)
+    text += std::to_string(1700000000000000000LL + i) + "," + std::to_string(i) + ",0,0,1,0,0,0\n";
+  const auto euroc = read_ok<SE3>(text);
+  REQUIRE(euroc.format == Format::euroc);
+  const std::vector<double> expected = {0, 1e-9, 2e-9, 3e-9, 4e-9};
+  REQUIRE(euroc.covariates == expected);
+  for (int i = 0; i < 5; ++i) {
+    REQUIRE(euroc.timestamps[i].text == std::to_string(1700000000000000000LL + i));
+  }
+  REQUIRE(bireg::io::render_timestamp(euroc.timestamps[3], TimeUnit::seconds) ==
+          "1700000000.000000003");
+  REQUIRE(bireg::io::render_timestamp(euroc.timestamps[3], TimeUnit::nanoseconds) ==
+          "1700000000000000003");
+
+  // TUM seconds with microsecond digits; the earliest line need not be first.
+  const auto tum = read_ok<SE3>(
+      "1700000000.000003 0 0 0 0 0 0 1\n1700000000.000001 0 0 0 0 0 0 1\n"
+      "1700000000.000002 1 0 0 0 0 0 1\n");
+  REQUIRE(tum.origin.text == "1700000000.000001");
+  REQUIRE(tum.covariates == std::vector<double>{2e-6, 0, 1e-6});
+  REQUIRE(bireg::io::render_timestamp(tum.timestamps[0], TimeUnit::nanoseconds) ==
+          "1700000000000003000");
+
+  // Exponents, signs and values beyond 18 digits.
+  const auto t = timestamps_of({"1.036594e-01", "-2.5", "-0.000001", "12345678901234567890"},
+                               TimeUnit::seconds);
+  REQUIRE(t[0].exact);
+  REQUIRE(bireg::io::render_timestamp(t[0], TimeUnit::seconds) == "0.1036594");
+  REQUIRE(bireg::io::render_timestamp(t[1], TimeUnit::seconds) == "-2.5");
+  REQUIRE(bireg::io::render_timestamp(t[2], TimeUnit::nanoseconds) == "-1000");
+  REQUIRE(bireg::io::seconds_between(t[0], t[1]) == 2.6036594);
+  REQUIRE_FALSE(t[3].exact);
+  REQUIRE(t[3].seconds == 12345678901234567890.0);
+}
+
+namespace {
+
+// The same poses written in `format`, with timestamps in its unit.
+std::string write_as(Format format, const std::vector<std::string>& seconds,
+                     const std::vector<std::string>& nanoseconds,
+                     const std::vector<SE3::Element>& poses) {
+  const auto& texts = format == Format::euroc ? nanoseconds : seconds;
+  return bireg::io::format_trajectory<SE3>(
+      format, format, timestamps_of(texts, bireg::io::time_unit(format)), poses);
+}
+
+}  // namespace
+
+TEST_CASE("round trip: every format read, written, read again", "[io]") {
+  const auto poses = random_poses(25, 3);
+  std::vector<std::string> seconds, nanoseconds;
+  for (int i = 0; i < 25; ++i) {
+    seconds.push_back("1700000000." + std::to_string(100000 + 37 * i));
+    nanoseconds.push_back(std::to_string(1700000000100000000LL + 37000LL * i));
+  }
+  for (Format format : {Format::matrix, Format::tum, Format::euroc, Format::kitti}) {
+    CAPTURE(bireg::io::to_string(format));
+    bireg::io::ReadOptions options;
+    options.format = format;
+    const auto times = timestamps_of(seconds, bireg::io::TimeUnit::seconds);
+    options.times = &times;
+    const auto first = read_ok<SE3>(write_as(format, seconds, nanoseconds, poses), options);
+    const std::string written =
+        bireg::io::format_trajectory<SE3>(format, format, first.timestamps, first.observations);
+    const auto second = read_ok<SE3>(written, options);
+    REQUIRE(second.observations.size() == poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      // Matrices print exactly; quaternions go through a rotation matrix and
+      // back: a few ulps.
+      REQUIRE(bireg_test::relative_error(second.observations[i], poses[i]) <= 1e-14);
+      if (format == Format::matrix || format == Format::kitti) {
+        REQUIRE(second.observations[i] == first.observations[i]);
+      }
+      REQUIRE(second.timestamps[i].text == first.timestamps[i].text);
+      REQUIRE(second.covariates[i] == first.covariates[i]);
+    }
+    // Auto-detection reads the written text as the same format.
+    bireg::io::ReadOptions detect;
+    detect.times = &times;
+    REQUIRE(read_ok<SE3>(written, detect).format == format);
+    // SO3 reads the rotations of every pose format.
+    if (format != Format::matrix) {
+      const auto rotations = read_ok<SO3>(written, options);
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        const SO3::Element r = poses[i].topLeftCorner<3, 3>();
+        REQUIRE(bireg_test::relative_error(rotations.observations[i], r) <= 1e-14);
+      }
+    }
+  }
+  // Conversion between units is exact: TUM seconds to EuRoC nanoseconds and
+  // back gives the same value (the same text, trailing zeros aside).
+  const auto tum = read_ok<SE3>(write_as(Format::tum, seconds, nanoseconds, poses));
+  const std::string euroc =
+      bireg::io::format_trajectory<SE3>(Format::euroc, Format::tum, tum.timestamps, poses);
+  const auto back = read_ok<SE3>(euroc);
+  REQUIRE(back.format == Format::euroc);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    REQUIRE(back.timestamps[i].text == nanoseconds[i]);
+    REQUIRE(bireg::io::timestamp_text(back.timestamps[i], Format::euroc, Format::tum) ==
+            bireg::io::render_timestamp(tum.timestamps[i], bireg::io::TimeUnit::seconds));
+    REQUIRE(back.covariates[i] == tum.covariates[i]);
+  }
+}
+
+TEST_CASE("column counts: extra and missing columns are errors where the format fixes them",
+          "[io]") {
+  bireg::io::ReadOptions options;
+  const std::string so3 = "1, 1, 0, 0, 0, 1, 0, 0, 0, 1";
+  options.format = Format::matrix;
+  REQUIRE(read_error<SO3>(so3 + ", 0\n", options).message == "expected 10 numbers, found 11");
+  REQUIRE(read_error<SO3>("1, 1, 0, 0, 0, 1, 0, 0, 0\n", options).message ==
+          "expected 10 numbers, found 9");
+  options.format = Format::tum;
+  REQUIRE(read_error<SE3>("0 0 0 0 0 0 0 1 0\n", options).message ==
+          "expected 8 numbers (timestamp tx ty tz qx qy qz qw), found 9");
+  REQUIRE(read_error<SE3>("0 0 0 0 0 0 1\n", options).message ==
+          "expected 8 numbers (timestamp tx ty tz qx qy qz qw), found 7");
+  options.format = Format::kitti;
+  REQUIRE(read_error<SE3>("1 0 0 0 0 1 0 0 0 0 1 0 5\n", options).message ==
+          "expected 12 numbers (a 3x4 pose, row-major), found 13");
+  options.format = Format::euroc;
+  REQUIRE(read_error<SE3>("0,0,0,0,1,0,0\n", options).message ==
+          "expected at least 8 numbers (timestamp p_x p_y p_z q_w q_x q_y q_z), found 7");
+  // EuRoC ignores the columns after the eighth, unread.
+  const auto extra = read_ok<SE3>("0,0,0,0,1,0,0,0,v,w\n5,0,0,0,1,0,0,0,,\n", options);
+  REQUIRE(extra.observations.size() == 2);
+  REQUIRE(extra.covariates[1] == 5e-9);
+}
+
+TEST_CASE("format detection by content, ambiguity named", "[io]") {
+  REQUIRE(read_ok<SE3>("0 0 0 0 0 0 0 1\n").format == Format::tum);
+  REQUIRE(read_ok<SE3>("1 0 0 0 0 1 0 0 0 0 1 0\n").format == Format::kitti);
+  REQUIRE(read_ok<SO3>("0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n").format == Format::matrix);
+  REQUIRE(read_ok<SE3>("# timestamp\n0,0,0,0,1,0,0,0\n").format == Format::euroc);
+  // Without the header, a comma-separated 8-column line is no format.
+  REQUIRE(read_error<SE3>("0,0,0,0,1,0,0,0\n").message.find("no format fits") == 0);
+  // A header mentioning timestamps and a 10-column SO3 line valid both as a
+  // matrix and as EuRoC (identity rotation, unit quaternion (0, 1, 0, 0)).
+  const auto ambiguous = read_error<SO3>("#timestamp\n0, 1, 0, 0, 0, 1, 0, 0, 0, 1\n");
+  REQUIRE(ambiguous.line == 2);
+  REQUIRE(ambiguous.message.find("ambiguous format") == 0);
+  REQUIRE(ambiguous.message.find("matrix or euroc") != std::string::npos);
+  // The same line as a rotation that is not EuRoC-valid: matrix.
+  REQUIRE(read_ok<SO3>("#timestamp\n0, 0, 0, 1, 0, 1, 0, -1, 0, 0\n").format == Format::matrix);
+  // Other groups read the matrix format without detection.
+  REQUIRE(read_ok<bireg::SE2<double>>("0 1 0 0 0 1 0 0 0 1\n").format == Format::matrix);
+}
+
+TEST_CASE(
+    "projection (--project): quaternions normalised, rotation blocks projected, degenerate refused",
+    "[io]") {
+  bireg::io::ReadOptions strict, project;
+  project.project = true;
+  const std::string tum = "0 0 0 0 0 0 0 1.01\n1 1 0 0 0 0 0 1\n";
+  REQUIRE(read_error<SE3>(tum, strict).message.find("quaternion norm 1.01 is far from 1") == 0);
+  const auto projected = read_ok<SE3>(tum, project);
+  REQUIRE(std::abs(projected.projection_correction - 0.01) < 1e-12);
+  REQUIRE(SE3::is_element(projected.observations[0], 1e-14));
+  REQUIRE(read_error<SE3>("0 0 0 0 0 0 0 0\n", project).message.find("too small") !=
+          std::string::npos);
+
+  const std::string kitti = "1.001 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n";
+  REQUIRE(read_error<SE3>(kitti, strict).message.find("not an element of SE3") !=
+          std::string::npos);
+  const auto k = read_ok<SE3>(kitti, project);
+  REQUIRE(std::abs(k.projection_correction - 0.001) < 1e-12);
+  REQUIRE(k.observations[0].isIdentity(1e-14));
+  REQUIRE(read_error<SE3>("1 0 0 0 0 0 0 0 0 0 0 0\n", project).message.find("rank < 2") !=
+          std::string::npos);
+  // Matrix format, SO3: a rotation off by 1e-4 in one entry.
+  const std::string matrix = "0, 1, 1e-4, 0, 0, 1, 0, 0, 0, 1\n";
+  REQUIRE(read_error<SO3>(matrix, strict).message.find("--project") != std::string::npos);
+  const auto m = read_ok<SO3>(matrix, project);
+  REQUIRE(m.projection_correction > 0);
+  REQUIRE(m.projection_correction < 1e-4);
+  REQUIRE(SO3::is_element(m.observations[0], 1e-14));
+  REQUIRE(read_error<bireg::SL3<double>>("0 1 0 0 0 1 0 0 0 1\n", project)
+              .message.find("--project applies") == 0);
+}
+
+TEST_CASE("KITTI times: one per pose, counted", "[io]") {
+  bireg::io::MemorySource times_text("# times\n0.0\n1.036594e-01\n2.073188e-01\n");
+  std::vector<bireg::io::Timestamp> times;
+  REQUIRE_FALSE(bireg::io::read_times(times_text, times));
+  REQUIRE(times.size() == 3);
+  bireg::io::ReadOptions options;
+  options.times = &times;
+  const std::string pose = "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const auto k = read_ok<SE3>(pose + pose + pose, options);
+  REQUIRE(k.covariates[2] == 0.2073188);
+  REQUIRE(read_error<SE3>(pose + pose, options).message == "3 times for 2 poses");
+  REQUIRE(read_error<SE3>(pose + pose + pose + pose, options).line == 4);
+  REQUIRE(read_ok<SE3>(pose + pose).covariates == std::vector<double>{0, 1});
+  bireg::io::MemorySource bad("0\n1 2\n");
+  const auto e = bireg::io::read_times(bad, times);
+  REQUIRE(e);
+  REQUIRE(e->line == 2);
+}
+
+TEST_CASE("write errors are reported", "[io]") {
+  std::FILE* full = std::fopen("/dev/full", "wb");
+  if (!full) {
+    WARN("no /dev/full: skipped");
+    return;
+  }
+  const auto poses = random_poses(3, 1);
+  const auto times = timestamps_of({"0", "1", "2"}, bireg::io::TimeUnit::seconds);
+  const auto error = bireg::io::write_trajectory<SE3>(full, Format::tum, Format::tum, times, poses);
+  std::fclose(full);
+  REQUIRE(error);
+  REQUIRE(error->find("write error") == 0);
+}
+
+TEST_CASE("JSON numbers are never nan or inf", "[io]") {
+  REQUIRE(bireg::io::json_number(std::nan("")) == "null");
+  REQUIRE(bireg::io::json_number(-HUGE_VAL) == "null");
+  REQUIRE(bireg::io::json_number(0.1) == "0.1");
+  Eigen::Matrix2d m;
+  m << 1, std::nan(""), HUGE_VAL, 2;
+  REQUIRE(bireg::io::json_matrix(m) == "[[1, null], [null, 2]]");
+}
