@@ -111,10 +111,10 @@ bool solve(SquareMatrix<Scalar, N> a, const SquareMatrix<Scalar, N>& b, SquareMa
 // 200 series terms, bisection): for u = 2^-53 they reproduce the paper's
 // Table 2.3 to all 16 digits, and for u = 2^-24 the single-precision values
 // the paper quotes; 2^-64 (x87 long double) and 2^-113 (IEEE quad) are the
-// same computation at those unit roundoffs. Degrees follow the paper's
-// recommendation: up to 13 for double and wider (13 minimises the cost per
-// unit of norm), up to 7 for single precision (higher degrees gain nothing
-// there since theta_7 already exceeds the norm at which squaring dominates).
+// same computation at those unit roundoffs. Degrees follow the paper: 13 is
+// the degree that minimises matrix products per unit of norm in double (and
+// we keep it for the wider types, where it remains the cheapest per unit of
+// norm among 3..13), and 7 is its choice for single precision.
 
 // Coefficients of the numerator p_m(x) = sum_j c_j x^j of r_m = p_m(x) /
 // p_m(-x), normalised to c_0 = 1:
