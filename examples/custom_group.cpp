@@ -26,7 +26,7 @@
 struct UnitriangularBasis {
   static constexpr int dof = 3;
   static constexpr const char* name = "Unitriangular3";
-  static constexpr bool log_everywhere = true;  // unipotent: exp and log are polynomials
+  static constexpr int nilpotency_order = 3;  // X^3 = 0: exp and log are polynomials
 
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {  // X = E01, Y = E12, Z = E02

@@ -3,20 +3,27 @@
 // closed forms and terminating series, exp/log from tiny to near the branch
 // cut, and the log's domain (the regression on them: test_scene_groups.cpp).
 //
-// Tolerance: Eigen's matrix exponential (Pade with scaling and squaring)
-// and logarithm (Schur-Parlett with inverse scaling and squaring) are
-// backward stable to a few hundred epsilon at the norms used here (tangent
-// entries up to 0.5, so no eigenvalue near the log's branch cut); identities
-// that chain two or three of them are allowed 1e-12 relative, ~5000 epsilon,
-// far below the O(1) error of a wrong sign or basis.
+// Tolerance: the matrix exponential (Pade with scaling and squaring) and
+// logarithm (inverse scaling and squaring) of bireg/math/matrix_functions.hpp
+// are within ~10 epsilon of a long double reference at the norms used here
+// (tangent entries up to 0.5, so no eigenvalue near the log's branch cut);
+// identities that chain two or three of them are allowed 1e-12 relative,
+// ~5000 epsilon, far below the O(1) error of a wrong sign or basis.
+//
+// Hostile inputs (huge, non-finite, on the branch cut) must come back as NaN
+// within a bounded time: Eigen's logarithm looped for ever on some and its
+// Schur decomposition asserted on others.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include "bireg/concept.hpp"
 #include "bireg/math/psi_series.hpp"
 #include "bireg/groups/matrix_group.hpp"
+#include "bireg/math/matrix_functions.hpp"
 #include "bireg/regression.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -27,6 +34,18 @@ using bireg_test::relative_error;
 namespace {
 constexpr double kTolerance = 1e-12;
 constexpr double kScale = 0.5;
+
+// Runs f and requires that it returns within one second: a hang guard (the
+// functions under test take microseconds), not a speed requirement.
+template <class F>
+auto within_a_second(F f) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto result = f();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  REQUIRE(seconds < 1.0);
+  return result;
+}
 }  // namespace
 
 TEMPLATE_TEST_CASE("matrix groups satisfy the group identities", "[matrix_group]",
@@ -127,8 +146,8 @@ TEMPLATE_TEST_CASE("matrix groups: exp and log from tiny to near the branch cut"
   }
 }
 
-// Outside the principal log's domain Eigen's log is not a logarithm; bireg
-// returns NaN there and the fit names the observation.
+// Outside the principal log's domain no logarithm is returned: bireg returns
+// NaN there and the fit names the observation.
 TEST_CASE("matrix groups: log outside its domain is NaN, and the fit says so",
           "[matrix_group][errors]") {
   using G = bireg::SL3<double>;
@@ -155,7 +174,105 @@ TEST_CASE("matrix groups: log outside its domain is NaN, and the fit says so",
   REQUIRE(result.bad_index == 4);
   REQUIRE(result.message.find("observation 4 is out of reach") != std::string::npos);
 
-  // The Heisenberg group declares that its log exists everywhere.
+  // The Heisenberg group's log is a polynomial, defined everywhere.
   const bireg::Heisenberg<double>::Element h = bireg::Heisenberg<double>::exp({1e3, -1e3, 5.0});
   REQUIRE(bireg::Heisenberg<double>::log(h).allFinite());
+}
+
+// Inputs on which Eigen's MatrixFunctions hung (inverse scaling and squaring
+// never terminating once a norm became NaN) or aborted (its Schur
+// decomposition's assertion, in builds without NDEBUG): each now returns
+// NaN, at once.
+TEMPLATE_TEST_CASE("matrix groups: hostile inputs give NaN, never a hang or an abort",
+                   "[matrix_group][errors]", bireg::SL3<double>, (bireg::GLp<3, double>)) {
+  using G = TestType;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto log_is_nan = [](const Element& g) {
+    const Tangent y = within_a_second([&] { return G::log(g); });
+    return y.array().isNaN().all();
+  };
+
+  // Unit upper triangular, one entry 1.1e63 (in GL+(3) and SL(3)): its
+  // logarithm would need ~210 square roots; refused after 64.
+  Element shear = Element::Identity();
+  shear(0, 2) = 1.1e63;
+  REQUIRE(log_is_nan(shear));
+  // The same entry in a dense matrix with negative determinant: a negative
+  // real eigenvalue, no real logarithm.
+  Element dense;
+  dense << 2, 1.1e63, 0.3, 0.1, 1, 0, 0, 0, 1;
+  REQUIRE(log_is_nan(dense));
+  // Unit upper triangular with 1e200 entries: its inverse overflows.
+  Element huge = Element::Identity();
+  huge(0, 1) = huge(0, 2) = huge(1, 2) = 1e200;
+  REQUIRE(log_is_nan(huge));
+  // The rotation by exactly pi about z: eigenvalues -1, -1 on the branch cut.
+  const Element half_turn = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+  REQUIRE(G::is_element(half_turn));
+  REQUIRE(log_is_nan(half_turn));
+  // exp of the rotation generator by pi in floating point (eigenvalues
+  // within 1e-16 of the cut): either refused or a true logarithm.
+  Eigen::Matrix3d skew = Eigen::Matrix3d::Zero();
+  skew(0, 1) = -1;
+  skew(1, 0) = 1;
+  const Element rounded_half_turn = G::exp(3.141592653589793 * G::vee(skew));
+  const Tangent y = within_a_second([&] { return G::log(rounded_half_turn); });
+  if (y.allFinite()) REQUIRE(relative_error(G::exp(y), rounded_half_turn) <= 1e-8);
+  // Non-finite entries.
+  for (double bad : {nan, inf, -inf}) {
+    Element g = Element::Identity();
+    g(1, 0) = bad;
+    REQUIRE(log_is_nan(g));
+    Tangent x = Tangent::Zero();
+    x[1] = bad;
+    REQUIRE_FALSE(within_a_second([&] { return G::exp(x); }).allFinite());
+  }
+  // exp of a huge tangent overflows to a flagged (non-finite) result after
+  // a bounded number of squarings instead of running on.
+  for (double size : {1e300, 1e30, 1e3}) {
+    CAPTURE(size);
+    const Tangent x = Tangent::Constant(size);
+    REQUIRE_FALSE(within_a_second([&] { return G::exp(x); }).allFinite());
+  }
+}
+
+// The matrix functions in every precision: exp within a few epsilon of the
+// long double reference, log inverting it, for random general 3x3 matrices
+// (gl(3), eigenvalues up to size in modulus) of the sizes of the range test
+// above.
+TEMPLATE_TEST_CASE("matrix functions: exp and log in float, double and long double",
+                   "[matrix_group][accuracy]", float, double, long double) {
+  using Scalar = TestType;
+  using Matrix = Eigen::Matrix<Scalar, 3, 3>;
+  using LongMatrix = Eigen::Matrix<long double, 3, 3>;
+  const long double epsilon = std::numeric_limits<Scalar>::epsilon();
+  // The reference is good to ~1e-18: long double's own test is limited by it.
+  const long double floor = std::max(epsilon, 1e-18L);
+  std::mt19937 rng(95);
+  long double worst_exp = 0, worst_log = 0;
+  for (double size : {0.0, 1e-30, 1e-8, 1e-3, 0.1, 0.5, 1.0, 2.0, 3.0}) {
+    for (int sample = 0; sample < 20; ++sample) {
+      const Eigen::Matrix<Scalar, 9, 1> entries =
+          random_tangent<Eigen::Matrix<Scalar, 9, 1>>(rng, 1.0);
+      Matrix a = Eigen::Map<const Matrix>(entries.data());
+      a *= Scalar(size) / std::max(a.norm(), Scalar(1e-30));
+      const LongMatrix reference = bireg_test::reference_expm<3>(a.template cast<long double>());
+      const Matrix e = bireg::math::matrix_exp(a);
+      const Matrix back = bireg::math::matrix_log(e);
+      REQUIRE(back.allFinite());
+      worst_exp = std::max(worst_exp, relative_error(e, reference) / floor);
+      worst_log =
+          std::max(worst_log, (back.template cast<long double>() - a.template cast<long double>())
+                                      .cwiseAbs()
+                                      .maxCoeff() /
+                                  (std::max(1.0, size) * floor));
+    }
+  }
+  CAPTURE(worst_exp, worst_log);
+  // Measured: <= 6 epsilon (exp) and <= 8 epsilon (log) in double.
+  REQUIRE(worst_exp <= 64);
+  REQUIRE(worst_log <= 64);
 }

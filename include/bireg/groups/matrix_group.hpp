@@ -1,52 +1,80 @@
 // bireg: any matrix Lie group, given a basis of its Lie algebra.
 //
 //   MatrixGroup<N, Basis, Scalar>: elements are N x N matrices, tangent
-//   coordinates are the coefficients in Basis; exp and log are Eigen's matrix
-//   exponential and principal matrix logarithm (unsupported/MatrixFunctions,
-//   shipped with libeigen3-dev), ad comes from commutators of the basis and
-//   Ad from conjugation.
+//   coordinates are the coefficients in Basis; exp and log are the matrix
+//   exponential and principal matrix logarithm of bireg/math/
+//   matrix_functions.hpp (Pade scaling and squaring; inverse scaling and
+//   squaring), ad comes from commutators of the basis and Ad from
+//   conjugation.
 //
 // A Basis is a struct with
 //   static constexpr int dof;                       // dimension of the algebra
 //   static constexpr const char* name;
 //   template <class S> static Eigen::Matrix<S, N, N> generator(int k);   // k < dof
 //   template <class S> static bool is_element(const Eigen::Matrix<S, N, N>&, S tol);
-// and optionally `static constexpr bool log_everywhere` (below)
+// and optionally
+//   static constexpr int nilpotency_order;          // p with X^p = 0 on the algebra
 // (see HeisenbergBasis, SL3Basis, GLBasis below: a dozen lines each).
 //
-// Domain of log: the principal matrix logarithm exists for matrices with no
-// eigenvalue on the closed negative real axis; there it is the unique
-// logarithm whose eigenvalues have imaginary parts in (-pi, pi). Outside it
-// (a rotation by pi inside SL(3), a negative eigenvalue) Eigen returns the
-// real part of a complex logarithm, which is no logarithm of the input at
-// all. MatrixGroup::log therefore checks exp(log g) = g (to sqrt(epsilon)
-// relative; outside the domain the mismatch is O(1)) and returns a tangent
-// of NaN when it fails. GeodesicRegression turns that into a status: data
-// that leave the domain as seen from their middle observation are
-// invalid_input (naming the observation); an iterate that leaves it stops
-// the fit with diverged and the last finite endpoints. A basis whose group
-// has a logarithm everywhere (unipotent groups such as Heisenberg) may
-// declare `static constexpr bool log_everywhere = true;` to skip the check.
-// Prefer the closed-form groups (SO3, SE3, Sim3, ...) where they exist: they
-// are exact to rounding and much faster.
+// Nilpotent algebras (unipotent groups such as Heisenberg): when every X in
+// the algebra has X^p = 0, and so every group element has (g - I)^p = 0, exp
+// and log are the terminating series
+//   exp(X) = sum_{k<p} X^k / k!,   log(g) = sum_{1<=k<p} (-1)^(k+1) (g - I)^k / k,
+// exact polynomials, defined everywhere, evaluated by Horner's rule in a few
+// matrix products. A Basis declares this with `nilpotency_order = p`; it is
+// the only way to opt out of the general matrix functions.
 //
-// The matrix functions allocate internally (dynamic Schur decompositions),
-// so fits on a MatrixGroup are not allocation-free, unlike the closed-form
-// groups.
+// Domain of log (general path): the principal matrix logarithm exists for
+// matrices with no eigenvalue on the closed negative real axis; there it is
+// the unique logarithm whose eigenvalues have imaginary parts in (-pi, pi).
+// Outside it (a rotation by pi inside SL(3), a negative eigenvalue pair) the
+// square-root iteration of matrix_log cannot converge (proof beside
+// math::matrix_sqrt), so log returns a tangent of NaN; so it does for inputs
+// that are not finite or whose logarithm is beyond ~2^63 in norm. Unlike a
+// Schur-based logarithm, no result is returned that is not a logarithm, so no
+// exp(log g) = g check is made. GeodesicRegression turns NaN into a status:
+// data that leave the domain as seen from their middle observation are
+// invalid_input (naming the observation); an iterate that leaves it stops
+// the fit with diverged and the last finite endpoints. Prefer the
+// closed-form groups (SO3, SE3, Sim3, ...) where they exist: they are exact
+// to rounding and faster.
+//
+// Everything is fixed-size: fits on a MatrixGroup do not allocate in their
+// iterations, like the closed-form groups.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <type_traits>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/matrix_functions.hpp"
 
 namespace bireg {
+
+namespace detail {
+// Basis::nilpotency_order if declared, else 0 (general matrix functions).
+template <class Basis, class = void>
+struct nilpotency_order_of : std::integral_constant<int, 0> {};
+template <class Basis>
+struct nilpotency_order_of<Basis, std::void_t<decltype(Basis::nilpotency_order)>>
+    : std::integral_constant<int, Basis::nilpotency_order> {};
+
+// {0, 1, 1/2, ..., 1/(Count-1)} at compile time: the nilpotent series
+// multiply by these instead of dividing at run time.
+template <class Scalar, int Count>
+constexpr std::array<Scalar, Count> inverse_integers() {
+  std::array<Scalar, Count> inverse{};
+  for (int k = 1; k < Count; ++k)
+    inverse[k] = Scalar(1) / Scalar(k);
+  return inverse;
+}
+}  // namespace detail
 
 template <int N, class Basis, class Scalar_ = double>
 struct MatrixGroup {
@@ -65,35 +93,51 @@ struct MatrixGroup {
   static Element compose(const Element& a, const Element& b) { return a * b; }
   static Element inverse(const Element& g) { return g.inverse(); }
 
-  static Element exp(const Tangent& x) { return Element(hat(x).exp()); }
+  // exp(hat x); not finite when it overflows.
+  static Element exp(const Tangent& x) {
+    const Algebra h = hat(x);
+    if constexpr (nilpotency_order() > 0) {
+      // sum_{k<p} h^k / k! = I + T_1 by Horner's rule,
+      //   T_{p-1} = h / (p-1),   T_k = (h + h T_{k+1}) / k:
+      // p - 2 matrix products (one for Heisenberg). The last step is
+      // written into the sum: exp = I + h + h T_2 (materialising T_1 first
+      // costs a store-forwarding stall, doubling Heisenberg's exp).
+      if constexpr (nilpotency_order() == 2) {
+        return Element::Identity() + h;
+      } else {
+        const Algebra product = h * exp_horner<2>(h);
+        return Element::Identity() + h + product;
+      }
+    } else {
+      return math::matrix_exp(h);
+    }
+  }
 
   // The principal logarithm, or NaN outside its domain (see above).
   static Tangent log(const Element& g) {
-    using std::sqrt;
-    const Algebra logarithm = g.log();
-    if constexpr (!log_everywhere()) {
-      const Scalar mismatch = (Element(logarithm.exp()) - g).cwiseAbs().maxCoeff();
-      const Scalar size = g.cwiseAbs().maxCoeff();
-      if (!(mismatch <= sqrt(std::numeric_limits<Scalar>::epsilon()) * size)) {
+    if constexpr (nilpotency_order() > 0) {
+      // With n = g - I, sum_{1<=k<p} (-1)^(k+1) n^k / k = T_1 by Horner's rule,
+      //   T_{p-1} = (-1)^p n / (p-1),   T_k = (-1)^(k+1) n / k + n T_{k+1}:
+      // p - 2 matrix products (one for Heisenberg: n - n^2/2).
+      return vee(log_horner<1>(Algebra(g - Element::Identity())));
+    } else {
+      const Algebra logarithm = math::matrix_log(g);
+      if (!logarithm.allFinite())
         return Tangent::Constant(std::numeric_limits<Scalar>::quiet_NaN());
-      }
+      return vee(logarithm);
     }
-    return vee(logarithm);
   }
 
+  // sum_k x_k E_k, as one product with the stacked basis (vec E_1 ... vec E_dof).
   static Algebra hat(const Tangent& x) {
-    Algebra m = Algebra::Zero();
-    for (int k = 0; k < dof; ++k)
-      m += x[k] * generator(k);
-    return m;
+    const FlatAlgebra flat = basis_matrix() * x;
+    return Eigen::Map<const Algebra>(flat.data());
   }
 
   // The coefficients of the basis combination nearest to m (Frobenius
   // norm): exact for m in the algebra, a projection otherwise.
   static Tangent vee(const Algebra& m) {
-    const Eigen::Matrix<Scalar, N * N, 1> flat =
-        Eigen::Map<const Eigen::Matrix<Scalar, N * N, 1>>(m.data());
-    return projector() * flat;
+    return projector() * Eigen::Map<const FlatAlgebra>(m.data());
   }
 
   // ad_x e_k = vee([hat x, E_k]).
@@ -121,21 +165,57 @@ struct MatrixGroup {
   }
 
  private:
-  template <class B, class = void>
-  struct declares_log_everywhere : std::false_type {};
-  template <class B>
-  struct declares_log_everywhere<B, std::void_t<decltype(B::log_everywhere)>>
-      : std::bool_constant<B::log_everywhere> {};
-  static constexpr bool log_everywhere() { return declares_log_everywhere<Basis>::value; }
+  // The Horner steps T_K of the nilpotent series (see exp and log),
+  // unrolled at compile time.
+  template <int K>
+  static Algebra exp_horner(const Algebra& h) {
+    constexpr auto inverse = detail::inverse_integers<Scalar, nilpotency_order()>();
+    if constexpr (K == nilpotency_order() - 1) {
+      return h * inverse[K];
+    } else {
+      const Algebra inner = exp_horner<K + 1>(h);
+      const Algebra product = h * inner;
+      return (h + product) * inverse[K];
+    }
+  }
+  template <int K>
+  static Algebra log_horner(const Algebra& n) {
+    constexpr auto inverse = detail::inverse_integers<Scalar, nilpotency_order()>();
+    constexpr Scalar coefficient = K % 2 == 1 ? inverse[K] : -inverse[K];
+    if constexpr (K == nilpotency_order() - 1) {
+      return coefficient * n;
+    } else {
+      const Algebra inner = log_horner<K + 1>(n);
+      const Algebra product = n * inner;
+      return coefficient * n + product;
+    }
+  }
 
-  // (B^T B)^{-1} B^T with B = [vec E_1 ... vec E_dof], computed once.
-  static const Eigen::Matrix<Scalar, dof, N * N>& projector() {
-    static const Eigen::Matrix<Scalar, dof, N* N> p = [] {
-      Eigen::Matrix<Scalar, N * N, dof> b;
+  static constexpr int nilpotency_order() { return detail::nilpotency_order_of<Basis>::value; }
+  static_assert(detail::nilpotency_order_of<Basis>::value == 0 ||
+                    detail::nilpotency_order_of<Basis>::value >= 2,
+                "nilpotency_order p means X^p = 0 on a nonzero algebra: p >= 2");
+
+  using FlatAlgebra = Eigen::Matrix<Scalar, N * N, 1>;
+  using BasisMatrix = Eigen::Matrix<Scalar, N * N, dof>;
+
+  // B = [vec E_1 ... vec E_dof], computed once.
+  static const BasisMatrix& basis_matrix() {
+    static const BasisMatrix b = [] {
+      BasisMatrix columns;
       for (int k = 0; k < dof; ++k) {
         const Algebra e = generator(k);
-        b.col(k) = Eigen::Map<const Eigen::Matrix<Scalar, N * N, 1>>(e.data());
+        columns.col(k) = Eigen::Map<const FlatAlgebra>(e.data());
       }
+      return columns;
+    }();
+    return b;
+  }
+
+  // (B^T B)^{-1} B^T, computed once.
+  static const Eigen::Matrix<Scalar, dof, N * N>& projector() {
+    static const Eigen::Matrix<Scalar, dof, N* N> p = [] {
+      const BasisMatrix& b = basis_matrix();
       const Eigen::Matrix<Scalar, dof, dof> gram = b.transpose() * b;
       return Eigen::Matrix<Scalar, dof, N * N>(gram.inverse() * b.transpose());
     }();
@@ -145,11 +225,13 @@ struct MatrixGroup {
 
 // The Heisenberg group: unit upper-triangular 3x3 matrices. Its algebra is
 // nilpotent ([X, Y] = Z central), so ad_x^2 = 0 and the inverse-differential
-// series terminates after its linear term.
+// series terminates after its linear term; strictly upper-triangular 3x3
+// matrices have X^3 = 0, so exp(X) = I + X + X^2/2 and log(g) = (g - I) -
+// (g - I)^2/2 exactly.
 struct HeisenbergBasis {
   static constexpr int dof = 3;
   static constexpr const char* name = "Heisenberg";
-  static constexpr bool log_everywhere = true;  // unipotent: log is a polynomial
+  static constexpr int nilpotency_order = 3;
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {
     Eigen::Matrix<S, 3, 3> e = Eigen::Matrix<S, 3, 3>::Zero();
