@@ -372,7 +372,8 @@ Sample make_sample(int n) {
 }
 
 Eigen::Vector4d quaternion_wxyz(const Eigen::Matrix3d& r) {
-  return bireg::SO3<double>::to_quaternion(r);
+  const Eigen::Quaterniond q = bireg::SO3<double>::to_quaternion(r);
+  return {q.w(), q.x(), q.y(), q.z()};
 }
 
 std::string write_sample(const Sample& s, bireg::io::Format format) {

@@ -52,6 +52,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/matrix_functions.hpp"
 

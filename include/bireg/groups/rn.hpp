@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "bireg/groups/capabilities.hpp"
+
 namespace bireg {
 
 template <int N, class Scalar_ = double>

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "bireg/groups/affine.hpp"
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/small_angle.hpp"

@@ -18,6 +18,7 @@
 
 #include "bireg/groups/affine.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/small_angle.hpp"

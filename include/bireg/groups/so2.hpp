@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
 
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/small_angle.hpp"
