@@ -1,5 +1,5 @@
 // A group without AdMatrix: the concept names every type it needs.
-// expect-error: bireg group concept: G must define Scalar, Element, Tangent, AdMatrix, Algebra, static constexpr int dof and static constexpr const char* name
+// expect-error: bireg group concept: G must define Scalar, Element, Tangent, AdMatrix, static constexpr int dof and static constexpr const char* name
 #define BIREG_TOY_NO_ADMATRIX
 #include "toy_group.hpp"
 

@@ -6,9 +6,8 @@
 // unbroken group satisfies the concept, so that each test fails for its own
 // reason only.
 //
-// Includes bireg/regression.hpp, which includes the concept header under
-// either layout (bireg/core/concept.hpp before issue 12, bireg/concept.hpp
-// after).
+// Includes bireg/regression.hpp (and with it bireg/concept.hpp), so the
+// regression's own static_assert is exercised too.
 #pragma once
 
 #include <cmath>
