@@ -18,7 +18,8 @@
 //
 // Iteration (IRLS), each refit warm-started from the previous endpoints:
 //
-//   0. the plain fit (all robust weights 1) and its scatter S;
+//   0. the plain fit (all robust weights 1) and its scatter S (a plain fit
+//      that did not converge still serves as the start);
 //   1. d_i from the current residuals and S; robust weights w_i = psi(d_i)/d_i;
 //   2. stop if max_i |w_i - w_i(previous)| <= weight_tolerance (the weights
 //      have settled: the last fit used weights within that of the ones its
@@ -101,7 +102,9 @@ enum class RobustStatus {
   max_rounds,        // the round limit came first: the last fit is returned
   too_few_good,      // fewer observations with positive weight than the model needs
   singular_scatter,  // the residuals do not spread in every direction of the algebra
-  fit_failed,        // a (re)fit did not converge or refused the data: see fit.status
+  fit_failed,        // the plain fit refused the data, or the last fit did not
+                     // converge: see fit.status (earlier failed refits are only
+                     // starts for the next round)
   invalid_input,     // a robust option is out of range
 };
 
@@ -192,7 +195,11 @@ class RobustGeodesicRegression {
     const GeodesicRegression<G> regression(regression_);
     result.fit = regression.fit(observations, covariates, weights);
     result.fit_iterations = result.fit.iterations;
-    if (!result.fit.ok()) return fit_failed(std::move(result), "the plain fit");
+    // A plain fit that failed but returned endpoints (no_descent,
+    // max_iterations, ...: gross outliers can take the data outside the
+    // plain estimator's domain) is a start like any other: the reweighting
+    // can bring the fit back. Only refused data end here.
+    if (!result.fit.geodesic) return fit_failed(std::move(result), "the plain fit");
 
     const std::size_t n = observations.size();
     const std::vector<Scalar> user = weights.empty() ? std::vector<Scalar>(n, Scalar(1)) : weights;
@@ -247,7 +254,7 @@ class RobustGeodesicRegression {
         ++result.rounds;
         if (stage + 1 < stages) ++result.huber_rounds;
         result.fit_iterations += result.fit.iterations;
-        if (!result.fit.ok()) return fit_failed(std::move(result), "a reweighted fit");
+        if (!result.fit.geodesic) return fit_failed(std::move(result), "a reweighted fit");
         if (!update_scatter(result, user, combined)) return result;
       }
       if (!settled) break;
@@ -262,6 +269,7 @@ class RobustGeodesicRegression {
     for (std::size_t i = 0; i < n; ++i) {
       if (user[i] > 0 && result.distances[i] > flag_distance) result.outliers.push_back(i);
     }
+    if (!result.fit.ok()) return fit_failed(std::move(result), "the final fit");
     result.status = settled ? RobustStatus::converged : RobustStatus::max_rounds;
     result.message = settled ? "the weights settled after " + std::to_string(result.rounds) +
                                    " reweighted fits; " + std::to_string(result.outliers.size()) +
