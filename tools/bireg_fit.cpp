@@ -5,6 +5,7 @@
 //             [--method exact|series|series_adaptive] [--order M]
 //             [--solver paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
+//             [--loss huber|cauchy|tukey [--loss-scale C]]
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]] FILE|-
 //
 // The formats, their detection when --format is omitted, --times and
@@ -12,6 +13,11 @@
 // Sim3 (4x4 [s R t; 0 1]), SL3 and GLp3 (3x3) read the matrix format only.
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
+//
+// --loss fits robustly (bireg/statistics/robust.hpp: reweighting on the
+// residuals' Mahalanobis distances, C defaulting to 95% Gaussian
+// efficiency); the JSON then has a "robust" object with the flagged
+// outliers' input line numbers, and exit code 3 when it did not converge.
 //
 // Prints one JSON object on stdout. Exit codes: 0 converged, 2 invalid input
 // or usage (one line on stderr naming file, line and problem), 3 the fit did
@@ -37,6 +43,7 @@
 #include "bireg/io/line_reader.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/robust.hpp"
 
 namespace {
 
@@ -50,6 +57,7 @@ constexpr const char* kUsage =
     "                 [--method exact|series|series_adaptive] [--order M]\n"
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
+    "                 [--loss huber|cauchy|tukey [--loss-scale C]]\n"
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
     "                 FILE|-\n";
 
@@ -67,6 +75,8 @@ struct Command {
   std::string output_trajectory;
   std::optional<bireg::io::Format> output_format;  // empty: the input's
   std::string input;
+  std::optional<bireg::Loss> loss;
+  double loss_scale = 0;  // 0: the 95%-efficiency default
 };
 
 int fail(const std::string& message) {
@@ -157,6 +167,15 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       if (!parse_count(*v, command.max_iterations) || command.max_iterations < 1) {
         return "--max-iter needs a positive integer";
       }
+    } else if (arg == "--loss") {
+      for (bireg::Loss loss : {bireg::Loss::huber, bireg::Loss::cauchy, bireg::Loss::tukey}) {
+        if (*v == bireg::to_string(loss)) command.loss = loss;
+      }
+      if (!command.loss) return "unknown loss '" + *v + "' (huber, cauchy or tukey)";
+    } else if (arg == "--loss-scale") {
+      if (!parse_number(*v, command.loss_scale) || !(command.loss_scale > 0)) {
+        return "--loss-scale needs a positive number";
+      }
     } else if (arg == "--output-trajectory") {
       command.output_trajectory = *v;
     } else {
@@ -176,6 +195,7 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   if (command.method != bireg::Method::series && order_given) {
     return "--order applies to --method series only";
   }
+  if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
   return std::nullopt;
 }
 
@@ -245,7 +265,21 @@ int run(const Command& command) {
   options.step_size = command.step;
   if (command.tolerance) options.tolerance = *command.tolerance;
   options.max_iterations = command.max_iterations;
-  const auto result = Regression(options).fit(trajectory.observations, trajectory.covariates);
+  std::optional<bireg::RobustResult<G>> robust;
+  typename Regression::Result plain;
+  if (command.loss) {
+    bireg::RobustOptions<double> robust_options;
+    robust_options.loss = *command.loss;
+    robust_options.loss_scale = command.loss_scale;
+    robust = bireg::RobustGeodesicRegression<G>(robust_options, options)
+                 .fit(trajectory.observations, trajectory.covariates);
+    if (robust->status == bireg::RobustStatus::invalid_input) {
+      return fail(name + ": " + robust->message);
+    }
+  } else {
+    plain = Regression(options).fit(trajectory.observations, trajectory.covariates);
+  }
+  const auto& result = robust ? robust->fit : plain;
   if (result.status == bireg::Status::invalid_input) {
     const std::uint64_t line =
         result.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(result.bad_index)] : 0;
@@ -290,7 +324,7 @@ int run(const Command& command) {
       "\"contraction_factor\": %s, \"method\": \"%s\", \"series_order\": %d, \"solver\": \"%s\", "
       "\"backtracks\": %d, "
       "\"force_norm\": %s, "
-      "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}}\n",
+      "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}",
       G::name, io::to_string(trajectory.format), trajectory.observations.size(), projection.c_str(),
       io::json_matrix(result.geodesic->start()).c_str(),
       io::json_matrix(result.geodesic->end()).c_str(),
@@ -302,13 +336,25 @@ int run(const Command& command) {
       bireg::to_string(command.method), d.series_order, bireg::to_string(command.solver),
       d.backtracks, json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
       json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
+  if (robust) {
+    std::string lines;  // the flagged observations' line numbers in the input
+    for (std::size_t i : robust->outliers) {
+      lines += (lines.empty() ? "" : ", ") + std::to_string(trajectory.lines[i]);
+    }
+    std::printf(
+        ",\n \"robust\": {\"loss\": \"%s\", \"loss_scale\": %s, \"status\": \"%s\", "
+        "\"rounds\": %d, \"outlier_lines\": [%s]}",
+        bireg::to_string(robust->loss), json_number(robust->loss_scale).c_str(),
+        bireg::to_string(robust->status), robust->rounds, lines.c_str());
+  }
+  std::printf("}\n");
   errno = 0;
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
     std::fprintf(stderr, "bireg_fit: <stdout>: write error: %s\n",
                  errno != 0 ? std::strerror(errno) : "unknown");
     return kExitWriteError;
   }
-  return result.ok() ? 0 : kExitNotConverged;
+  return result.ok() && (!robust || robust->ok()) ? 0 : kExitNotConverged;
 }
 
 }  // namespace

@@ -1,0 +1,368 @@
+// bireg: the covariance of a fit's endpoints by the sandwich K^{-1} M K^{-T}
+// (DESIGN.md section 5, "Covariance of the estimate").
+//
+// Write the estimate as g0^ = g0* exp(delta0), g1^ = g1* exp(delta1)
+// (left-trivialised). Linearising the estimating equations v(g^) = 0 of the
+// paper's Definition 2.1 about the truth gives delta ~ K^{-1} sum_i w_i
+// Psi_i eps_i, eps_i the true residuals, K the Gauss-Newton matrix of
+// DESIGN.md section 2 and
+//
+//   Psi_i = [psi_{1-t_i}(-A); psi_{t_i}(A)]   (2d x d, A = ad_X; Lemma 3.1,
+//                                              Corollary 3.2 of the paper),
+//
+// hence Cov(delta) ~ K^{-1} M K^{-T} with
+//
+//   homoscedastic:  M = sum_i w_i^2 Psi_i S Psi_i^T,  S = sum_i w_i r_i r_i^T / nu,
+//   robust (HC2):   M = sum_i w_i^2 Psi_i (r_i r_i^T / v_i) Psi_i^T.
+//
+// Weights are design weights (e.g. kernel weights of a local fit), not
+// precisions: the homoscedastic flavour assumes one error covariance for
+// every observation. On R^n, where r = (I - P) eps with P the weighted
+// hat matrix, E[sum w_i r_i r_i^T] = Sigma (W - tr(H^{-1} H_2)), W = sum w_i,
+// H = sum w_i l_i l_i^T (the paper's Lemma 3.7 matrix), H_2 = sum w_i^2 l_i
+// l_i^T, l_i = (1 - t_i, t_i); so the unbiased divisor is
+//
+//   nu = W - tr(H^{-1} H_2)     (= N - 2 for unit weights: the textbook N - 2),
+//
+// and the robust flavour divides each r_i r_i^T by its own expectation
+// factor v_i = 1 - 2 w_i l_i^T H^{-1} l_i + l_i^T H^{-1} H_2 H^{-1} l_i
+// (= 1 - h_ii, MacKinnon and White's HC2, for unit weights), which makes
+// it unbiased under homoscedasticity too. Both are invariant to a common
+// scale of the weights (K and nu scale like w, M like w^2). On R^n with
+// unit weights the homoscedastic covariance is exactly H^{-1} kron S, the
+// OLS covariance of the line's values at the interval's ends. The robust
+// flavour stays consistent when the noise level varies along t; for
+// precision weights (noise covariance Sigma / w_i) use it too.
+//
+// Degrees of freedom for the confidence regions. The homoscedastic flavour
+// estimates one d x d matrix S from nu degrees of freedom, and the
+// ellipsoids use Hotelling / Lawley-Hotelling quantiles with nu
+// (statistics/confidence.hpp). The robust flavour estimates the whole
+// covariance of a p-dimensional quantity L delta from N rank-one terms
+// z_i z_i^T, z_i = L K^{-1} w_i Psi_i r_i / sqrt(v_i), far more variable
+// than S: with the homoscedastic quantiles its 95% ellipsoids covered 84%
+// (SE(3) endpoints, N = 50) in simulation. Its degrees of freedom come from
+// Satterthwaite's moment match of a weighted sum of Wisharts: with kappa_i
+// = z_i^T C_L^{-1} z_i (C_L = sum z z^T, so sum kappa_i = p) and E[kappa_i^2]
+// inflated by (p + 2)/p for Gaussian z_i,
+//
+//   nu_L = p (p + 2) / sum_i kappa_i^2      (= N when all z_i are alike),
+//
+// computed from the data, so that it falls when a few observations
+// dominate (high leverage, or noise that grows along t), and used as the
+// error degrees of freedom of Hotelling's T^2 in dimension p (the
+// sandwich has no Kronecker structure to exploit). It is computed for the
+// endpoints together (p = 2d), each endpoint, and the velocity.
+//
+// Under left translation of the data every quantity here is unchanged;
+// under right translation by h, delta, r_i, Psi_i and K move by Ad_{h^{-1}}
+// (the paper's Theorem 2.4), so the covariance becomes (I2 kron Ad) C
+// (I2 kron Ad)^T.
+//
+// K. The fit's K (RegressionResult::jacobian) is a power series of order
+// kGaussNewtonOrder = 16 in A, accurate to ~(rho(A)/2 pi)^16 relative:
+// 6e-14 at 1 rad but only ~2e-5 at pi, enough to steer Newton's steps and
+// not quite what a covariance quoted to 4 digits should carry. Here K is
+// built exactly, per observation, from the closed forms (or fallback
+// series) of J_r: with psi_s(A) = s J_r(X) J_r(sX)^{-1} (DESIGN.md section
+// 2, "Exact form") and phi_s = psi_s / s^2,
+//
+//   K01 = sum_i w_i psi_{1-t_i}(-A) phi_{t_i}(A)^{-1}
+//       = J_r(-X) [sum_i w_i t_i u_i J_r(-u_i X)^{-1} J_r(t_i X)] J_r(X)^{-1},
+//   K10 = J_r(X) [sum_i w_i t_i u_i J_r(t_i X)^{-1} J_r(-u_i X)] J_r(-X)^{-1},
+//
+// u_i = 1 - t_i, and Psi_i = diag(J_r(-X), J_r(X)) [u_i J_r(-u_i X)^{-1};
+// t_i J_r(t_i X)^{-1}]: one pass, four d x d Jacobians per observation, the
+// constant outer factors applied once.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "bireg/concept.hpp"
+#include "bireg/geodesic.hpp"
+#include "bireg/regression/problem.hpp"
+#include "bireg/regression/result.hpp"
+
+namespace bireg {
+
+enum class CovarianceFlavour {
+  homoscedastic,  // one residual covariance S for all observations
+  robust,         // heteroscedasticity-robust sandwich (HC2)
+};
+
+inline const char* to_string(CovarianceFlavour flavour) {
+  return flavour == CovarianceFlavour::robust ? "robust" : "homoscedastic";
+}
+
+enum class CovarianceStatus {
+  defined,
+  invalid_input,  // the fit failed or the covariates/weights do not match it
+  undefined,      // no degrees of freedom, zero residuals, leverage 1: message says which
+};
+
+// Degrees of freedom of the quantities' covariance estimates.
+template <class Scalar>
+struct DegreesOfFreedom {
+  Scalar endpoints = 0;  // (delta0, delta1) together
+  Scalar start = 0;      // delta0
+  Scalar end = 0;        // delta1
+  Scalar velocity = 0;
+};
+
+template <class G>
+struct FitCovariance {
+  using Scalar = typename G::Scalar;
+  static constexpr int d = G::dof;
+  using AdMatrix = typename G::AdMatrix;
+  using EndpointMatrix = Eigen::Matrix<Scalar, 2 * d, 2 * d>;
+
+  CovarianceStatus status = CovarianceStatus::invalid_input;
+  std::string message;
+  CovarianceFlavour flavour = CovarianceFlavour::homoscedastic;
+  // Cov of (delta0, delta1), left-trivialised at the endpoints (zero unless defined).
+  EndpointMatrix endpoints = EndpointMatrix::Zero();
+  // The exact K at the estimate (see above).
+  EndpointMatrix jacobian = EndpointMatrix::Zero();
+  // S = sum w r r^T / nu: the residual (noise) covariance, both flavours.
+  AdMatrix residual = AdMatrix::Zero();
+  Scalar degrees_of_freedom = 0;  // nu, of S
+  // Of each quantity's covariance: nu for the homoscedastic flavour, the
+  // Satterthwaite values above for the robust one.
+  DegreesOfFreedom<Scalar> effective;
+  Geodesic<G> geodesic;  // the fit's
+
+  bool defined() const { return status == CovarianceStatus::defined; }
+};
+
+namespace covariance_detail {
+
+template <class G>
+FitCovariance<G> refused(CovarianceStatus status, std::string message) {
+  FitCovariance<G> c;
+  c.status = status;
+  c.message = std::move(message);
+  return c;
+}
+
+// A square root L of a symmetric positive semi-definite S (S = L L^T).
+template <class Matrix>
+Matrix square_root(const Matrix& s) {
+  const Eigen::SelfAdjointEigenSolver<Matrix> solver(s);
+  const auto root = solver.eigenvalues().cwiseMax(typename Matrix::Scalar(0)).cwiseSqrt();
+  return solver.eigenvectors() * root.asDiagonal();
+}
+
+// nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = map
+// force_i, C = sum z z^T (on C's numerical range: p its rank).
+template <class Map, class Force>
+typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& forces) {
+  using Scalar = typename Map::Scalar;
+  constexpr int p = Map::RowsAtCompileTime;
+  using Matrix = Eigen::Matrix<Scalar, p, p>;
+  using Vector = Eigen::Matrix<Scalar, p, 1>;
+  Matrix c = Matrix::Zero();
+  for (const Force& f : forces) {
+    const Vector z = map * f;
+    c.noalias() += z * z.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
+  const Vector values = solver.eigenvalues();
+  const Scalar largest = values[p - 1];
+  Vector inverse_root = Vector::Zero();
+  int rank = 0;
+  for (int k = 0; k < p; ++k) {
+    if (largest > 0 && values[k] > Scalar(1e-10) * largest) {
+      inverse_root[k] = 1 / std::sqrt(values[k]);
+      ++rank;
+    }
+  }
+  const Map whitening = inverse_root.asDiagonal() * solver.eigenvectors().transpose() * map;
+  Scalar sum = 0;
+  for (const Force& f : forces) {
+    const Scalar kappa = (whitening * f).squaredNorm();
+    sum += kappa * kappa;
+  }
+  return sum > 0 ? Scalar(rank * (rank + 2)) / sum : Scalar(0);
+}
+
+}  // namespace covariance_detail
+
+// The covariance of `fit`'s endpoints. `covariates` and `weights` must be
+// those of the fit (the interval is taken from fit.geodesic). Never throws
+// for bad input and never returns NaN: a covariance that cannot be
+// estimated is reported as undefined with a message.
+template <class G, class Covariates>
+FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& covariates,
+                            const std::vector<typename G::Scalar>& weights = {},
+                            CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
+  static_assert(check_lie_group<G>());
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+  using Result = FitCovariance<G>;
+  using EndpointMatrix = typename Result::EndpointMatrix;
+  using Block = Eigen::Matrix<Scalar, 2 * G::dof, G::dof>;
+  using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
+  using Matrix2 = Eigen::Matrix<Scalar, 2, 2>;
+  constexpr int d = G::dof;
+  using covariance_detail::refused;
+  using std::sqrt;
+
+  if (!fit.ok() || !fit.geodesic) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      std::string("the fit did not succeed (status ") + to_string(fit.status) +
+                          "): no covariance");
+  }
+  const std::size_t n = covariates.size();
+  if (fit.residuals.size() != n) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      "the covariates are not the fit's (" + std::to_string(n) + " vs " +
+                          std::to_string(fit.residuals.size()) + " residuals)");
+  }
+  const Geodesic<G>& geodesic = *fit.geodesic;
+  Problem<Scalar> problem;
+  const std::pair<CovariateScalar<Scalar>, CovariateScalar<Scalar>> interval(geodesic.t_min(),
+                                                                             geodesic.t_max());
+  if (auto rejection = make_problem(covariates, weights, std::optional(interval), problem)) {
+    return refused<G>(CovarianceStatus::invalid_input, rejection->message);
+  }
+
+  // nu = W - tr(H^{-1} H_2), and the matrix H^{-1} H_2 H^{-1} of the
+  // leverages, from the normalised weights (scale-free).
+  Matrix2 h, h2 = Matrix2::Zero();
+  h << problem.a, problem.b, problem.b, problem.c;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector2 l(1 - problem.t[i], problem.t[i]);
+    h2.noalias() += problem.w[i] * problem.w[i] * l * l.transpose();
+  }
+  const Matrix2 h_inverse = h.inverse();
+  const Scalar nu = problem.weight_sum - (h_inverse * h2).trace();
+  // Below this nu is rounding noise (N = 2 gives exactly 0 in exact arithmetic).
+  const Scalar nu_floor = Scalar(1e-9) * problem.weight_sum;
+  if (!(nu > nu_floor)) {
+    return refused<G>(CovarianceStatus::undefined,
+                      "no degrees of freedom left for the noise (N = " + std::to_string(n) +
+                          ", effective N - 2 = " + std::to_string(double(nu)) +
+                          "): the covariance is undefined");
+  }
+  const Matrix2 leverage_matrix = h_inverse * h2 * h_inverse;
+
+  AdMatrix residual_scatter = AdMatrix::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    residual_scatter.noalias() += problem.w[i] * fit.residuals[i] * fit.residuals[i].transpose();
+  }
+  const AdMatrix s = residual_scatter / nu;
+  if (!s.allFinite()) {
+    return refused<G>(CovarianceStatus::undefined, "the residuals are not finite");
+  }
+  // Zero residuals (noise-free data): residuals at the rounding level (rms
+  // below 1000 epsilon relative to the geodesic's size) estimate the noise
+  // as zero, which no confidence statement can be built on.
+  const Scalar rounding = Scalar(1000) * std::numeric_limits<Scalar>::epsilon();
+  const Scalar size = geodesic.displacement().squaredNorm() + 1;
+  if (!(s.trace() > rounding * rounding * size)) {
+    return refused<G>(CovarianceStatus::undefined,
+                      "the residuals vanish (noise-free data): the noise covariance, and with "
+                      "it the fit's covariance, is undefined");
+  }
+
+  const Tangent x = geodesic.displacement();
+  const AdMatrix s_root = covariance_detail::square_root(s);
+  using ForceVector = Eigen::Matrix<Scalar, 2 * d, 1>;
+  std::vector<ForceVector> forces;  // robust: w_i Psi_i r_i / sqrt(v_i), core part
+  if (flavour == CovarianceFlavour::robust) forces.reserve(n);
+  AdMatrix k01_core = AdMatrix::Zero(), k10_core = AdMatrix::Zero();
+  EndpointMatrix meat = EndpointMatrix::Zero();
+  Block psi_core;  // [u J_r(-uX)^{-1}; t J_r(tX)^{-1}]
+  for (std::size_t i = 0; i < n; ++i) {
+    const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
+    if (w == 0) continue;
+    const AdMatrix start_inverse = right_jacobian_inverse<G>(Tangent(-u * x));
+    const AdMatrix end_inverse = right_jacobian_inverse<G>(Tangent(t * x));
+    const AdMatrix start_jacobian = right_jacobian<G>(Tangent(-u * x));
+    const AdMatrix end_jacobian = right_jacobian<G>(Tangent(t * x));
+    k01_core.noalias() += (w * t * u) * start_inverse * end_jacobian;
+    k10_core.noalias() += (w * t * u) * end_inverse * start_jacobian;
+    psi_core.template topRows<d>() = u * start_inverse;
+    psi_core.template bottomRows<d>() = t * end_inverse;
+    if (flavour == CovarianceFlavour::homoscedastic) {
+      const Block spread = w * psi_core * s_root;
+      meat.template selfadjointView<Eigen::Lower>().rankUpdate(spread);
+    } else {
+      const Vector2 l(u, t);
+      const Scalar v = 1 - 2 * w * l.dot(h_inverse * l) + l.dot(leverage_matrix * l);
+      if (!(v > Scalar(1e-12))) {
+        return refused<G>(CovarianceStatus::undefined,
+                          "observation " + std::to_string(i) +
+                              " has leverage 1 (its residual is zero by construction): the "
+                              "robust covariance is undefined");
+      }
+      const ForceVector force = (w / sqrt(v)) * (psi_core * fit.residuals[i]);
+      meat.template selfadjointView<Eigen::Lower>().rankUpdate(force);
+      forces.push_back(force);
+    }
+  }
+  meat = meat.template selfadjointView<Eigen::Lower>();
+
+  const AdMatrix identity = AdMatrix::Identity();
+  const AdMatrix jacobian_back = right_jacobian<G>(Tangent(-x));
+  const AdMatrix jacobian_forward = right_jacobian<G>(x);
+  EndpointMatrix k;
+  k.template topLeftCorner<d, d>() = problem.a * identity;
+  k.template topRightCorner<d, d>() = jacobian_back * k01_core * right_jacobian_inverse<G>(x);
+  k.template bottomLeftCorner<d, d>() =
+      jacobian_forward * k10_core * right_jacobian_inverse<G>(Tangent(-x));
+  k.template bottomRightCorner<d, d>() = problem.c * identity;
+  // Cov = K^{-1} D meat D^T K^{-T}, D = diag(J_r(-X), J_r(X)).
+  EndpointMatrix outer = EndpointMatrix::Zero();
+  outer.template topLeftCorner<d, d>() = jacobian_back;
+  outer.template bottomRightCorner<d, d>() = jacobian_forward;
+  const Eigen::FullPivLU<EndpointMatrix> k_lu(k);
+  if (!k_lu.isInvertible()) {
+    return refused<G>(CovarianceStatus::undefined, "K is singular at the estimate");
+  }
+  const EndpointMatrix bread = k_lu.solve(outer);
+  EndpointMatrix c = bread * meat * bread.transpose();
+  c = ((c + c.transpose()) / 2).eval();
+  if (!c.allFinite()) {
+    return refused<G>(CovarianceStatus::undefined, "the covariance is not finite");
+  }
+
+  Result result;
+  result.effective = {nu, nu, nu, nu};
+  if (flavour == CovarianceFlavour::robust) {
+    const Eigen::Matrix<Scalar, d, 2 * d> start_map = Eigen::Matrix<Scalar, d, 2 * d>::Identity();
+    Eigen::Matrix<Scalar, d, 2 * d> end_map = Eigen::Matrix<Scalar, d, 2 * d>::Zero();
+    end_map.template rightCols<d>().setIdentity();
+    Eigen::Matrix<Scalar, d, 2 * d> velocity_map;
+    velocity_map.template leftCols<d>() = -right_jacobian_inverse<G>(Tangent(-x));
+    velocity_map.template rightCols<d>() = right_jacobian_inverse<G>(x);
+    result.effective.endpoints = covariance_detail::satterthwaite(EndpointMatrix(bread), forces);
+    result.effective.start = covariance_detail::satterthwaite(
+        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces);
+    result.effective.end =
+        covariance_detail::satterthwaite(Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces);
+    result.effective.velocity = covariance_detail::satterthwaite(
+        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces);
+  }
+  result.status = CovarianceStatus::defined;
+  result.flavour = flavour;
+  result.endpoints = c;
+  result.jacobian = k;
+  result.residual = s;
+  result.degrees_of_freedom = nu;
+  result.geodesic = geodesic;
+  return result;
+}
+
+}  // namespace bireg
