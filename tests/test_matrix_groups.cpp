@@ -25,6 +25,7 @@
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/math/matrix_functions.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/testing/group_laws.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
@@ -47,6 +48,29 @@ auto within_a_second(F f) {
   return result;
 }
 }  // namespace
+
+// The laws of bireg/testing/group_laws.hpp, as for every other group
+// (test_groups.cpp). Identities within kTolerance (see above); the finite
+// differences of exp err by O(epsilon^(2/3)) with a constant below 100.
+TEMPLATE_TEST_CASE("matrix groups satisfy the group laws", "[matrix_group]",
+                   bireg::Heisenberg<double>, bireg::SL3<double>, (bireg::GLp<3, double>)) {
+  using G = TestType;
+  std::mt19937 rng(92);
+  const auto e = bireg::testing::group_law_errors<G>(rng, 50, kScale);
+  CAPTURE(e.log_of_exp, e.exp_of_log, e.inverse, e.associativity, e.ad_antisymmetry, e.ad_exp,
+          e.ad_homomorphism, e.ad_conjugation, e.jacobian, e.jacobian_inverse, e.psi);
+  REQUIRE(e.log_of_exp <= kTolerance);
+  REQUIRE(e.exp_of_log <= kTolerance);
+  REQUIRE(e.inverse <= kTolerance);
+  REQUIRE(e.associativity <= kTolerance);
+  REQUIRE(e.ad_antisymmetry <= kTolerance);
+  REQUIRE(e.ad_exp <= kTolerance);
+  REQUIRE(e.ad_homomorphism <= kTolerance);
+  REQUIRE(e.ad_conjugation <= kTolerance);
+  REQUIRE(e.jacobian <= 100 * std::pow(2.220446049250313e-16, 2.0 / 3));
+  REQUIRE(e.jacobian_inverse <= kTolerance);
+  REQUIRE(e.psi <= kTolerance);
+}
 
 TEMPLATE_TEST_CASE("matrix groups satisfy the group identities", "[matrix_group]",
                    bireg::Heisenberg<double>, bireg::SL3<double>, (bireg::GLp<3, double>)) {

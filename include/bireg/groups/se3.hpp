@@ -17,8 +17,8 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "bireg/groups/affine.hpp"
-#include "bireg/groups/so3.hpp"
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/small_angle.hpp"
@@ -93,12 +93,8 @@ struct SE3 {
   // [xi_1, xi_2] = (w1 x rho2 - w2 x rho1, w1 x w2), so
   // ad_xi = [hat(omega) hat(rho); 0 hat(omega)].
   static AdMatrix ad(const Tangent& xi) {
-    AdMatrix m = AdMatrix::Zero();
-    const Matrix3 w = Rotation::hat(xi.template tail<3>());
-    m.template topLeftCorner<3, 3>() = w;
-    m.template bottomRightCorner<3, 3>() = w;
-    m.template topRightCorner<3, 3>() = Rotation::hat(xi.template head<3>());
-    return m;
+    return block_triangular(Rotation::hat(xi.template tail<3>()),
+                            Rotation::hat(xi.template head<3>()));
   }
 
   // ad_xi is block triangular with hat(omega) twice on the diagonal: its
@@ -110,12 +106,8 @@ struct SE3 {
   // g hat(xi) g^{-1} = hat(R rho + t x (R omega), R omega):
   // Ad_g = [R hat(t) R; 0 R].
   static AdMatrix Ad(const Element& g) {
-    AdMatrix m = AdMatrix::Zero();
     const Matrix3 r = g.template topLeftCorner<3, 3>();
-    m.template topLeftCorner<3, 3>() = r;
-    m.template bottomRightCorner<3, 3>() = r;
-    m.template topRightCorner<3, 3>() = Rotation::hat(g.template topRightCorner<3, 1>()) * r;
-    return m;
+    return block_triangular(r, Rotation::hat(g.template topRightCorner<3, 1>()) * r);
   }
 
   // Right Jacobian of exp (groups/capabilities.hpp). ad_xi = [W P; 0 W] is
@@ -127,20 +119,12 @@ struct SE3 {
   //   L = P/2 + e(t) (W P + P W) + (omega . rho) (e'(t)/t) W^2.
   // J_r itself is the block inverse [J, -J L J; 0, J], J = SO(3)'s J_r.
   static AdMatrix right_jacobian_inverse(const Tangent& xi) {
-    AdMatrix m = AdMatrix::Zero();
-    const Matrix3 j_inverse = Rotation::right_jacobian_inverse(xi.template tail<3>());
-    m.template topLeftCorner<3, 3>() = j_inverse;
-    m.template bottomRightCorner<3, 3>() = j_inverse;
-    m.template topRightCorner<3, 3>() = coupling_of_jacobian_inverse(xi);
-    return m;
+    return block_triangular(Rotation::right_jacobian_inverse(xi.template tail<3>()),
+                            coupling_of_jacobian_inverse(xi));
   }
   static AdMatrix right_jacobian(const Tangent& xi) {
-    AdMatrix m = AdMatrix::Zero();
     const Matrix3 j = Rotation::right_jacobian(xi.template tail<3>());
-    m.template topLeftCorner<3, 3>() = j;
-    m.template bottomRightCorner<3, 3>() = j;
-    m.template topRightCorner<3, 3>() = -j * coupling_of_jacobian_inverse(xi) * j;
-    return m;
+    return block_triangular(j, -j * coupling_of_jacobian_inverse(xi) * j);
   }
 
   // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
@@ -191,6 +175,16 @@ struct SE3 {
   };
 
  private:
+  // [diagonal upper; 0 diagonal]: the shape of ad, Ad and the Jacobians on
+  // SE(3), whose 6 x 6 matrices act on (rho, omega).
+  static AdMatrix block_triangular(const Matrix3& diagonal, const Matrix3& upper) {
+    AdMatrix m = AdMatrix::Zero();
+    m.template topLeftCorner<3, 3>() = diagonal;
+    m.template bottomRightCorner<3, 3>() = diagonal;
+    m.template topRightCorner<3, 3>() = upper;
+    return m;
+  }
+
   // L, the upper-right block of J_r^{-1} (see right_jacobian_inverse).
   static Matrix3 coupling_of_jacobian_inverse(const Tangent& xi) {
     using std::sqrt;
