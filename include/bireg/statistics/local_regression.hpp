@@ -1,0 +1,284 @@
+// bireg: kernel-weighted local geodesic regression (DESIGN.md section 5).
+//
+// At a query covariate tau the local estimate is the bi-invariant geodesic
+// regression (paper, Definition 2.1) of the observations with weights
+// w_i = K((t_i - tau) / h), K a kernel and h the bandwidth in covariate
+// units; the smoothed pose is gamma_tau(tau) and the body velocity is
+// gamma_tau's constant X_tau / (t_max - t_min) per covariate unit. On R^n
+// this is textbook local-linear kernel regression. Every local fit is left
+// and right equivariant (Theorem 2.4) because the weights depend on the
+// covariates only.
+//
+// Cost. The observations are sorted once (O(N log N)); a query touches only
+// the observations inside the kernel's support [tau - c h, tau + c h]
+// (c = kernel_support), found by binary search, and its fit's unit interval
+// is that window clipped to the data there (the `interval` option), so the
+// fit's conditioning does not depend on where the window lies. Queries are
+// processed in ascending order and each fit starts from the previous
+// query's geodesic evaluated at the new window's ends (fit_from): on smooth
+// data one or two Gauss-Newton iterations. The window's buffers are reused;
+// the fit itself still allocates its result's vectors (residuals, step
+// norms), O(window) per query.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bireg/concept.hpp"
+#include "bireg/geodesic.hpp"
+#include "bireg/regression.hpp"
+#include "bireg/statistics/confidence.hpp"
+#include "bireg/statistics/covariance.hpp"
+
+namespace bireg {
+
+enum class Kernel {
+  // exp(-u^2 / 2), truncated at |u| = 4: the omitted mass is
+  // erfc(4 / sqrt 2) = 6.3e-5 of the whole, and no weight inside the window
+  // is below exp(-8) = 3.4e-4 of the largest.
+  gaussian,
+  epanechnikov,  // 1 - u^2 on |u| < 1
+  tricube,       // (1 - |u|^3)^3 on |u| < 1
+};
+
+inline const char* to_string(Kernel kernel) {
+  switch (kernel) {
+    case Kernel::gaussian:
+      return "gaussian";
+    case Kernel::epanechnikov:
+      return "epanechnikov";
+    case Kernel::tricube:
+      return "tricube";
+  }
+  return "unknown";
+}
+
+// Half-width of the kernel's support, in bandwidths.
+inline double kernel_support(Kernel kernel) {
+  return kernel == Kernel::gaussian ? 4.0 : 1.0;
+}
+
+// K(u), zero outside the support.
+template <class Scalar>
+Scalar kernel_weight(Kernel kernel, Scalar u) {
+  using std::abs;
+  using std::exp;
+  const Scalar magnitude = abs(u);
+  if (!(magnitude < Scalar(kernel_support(kernel)))) return Scalar(0);
+  switch (kernel) {
+    case Kernel::gaussian:
+      return exp(-u * u / Scalar(2));
+    case Kernel::epanechnikov:
+      return Scalar(1) - u * u;
+    case Kernel::tricube: {
+      const Scalar inner = Scalar(1) - magnitude * magnitude * magnitude;
+      return inner * inner * inner;
+    }
+  }
+  return Scalar(0);
+}
+
+template <class Scalar>
+struct LocalRegressionOptions {
+  Kernel kernel = Kernel::gaussian;
+  Scalar bandwidth = Scalar(1);  // h, in covariate units
+  // Of every local fit; `interval` is set per query and must be empty here.
+  RegressionOptions<Scalar> fit;
+  // Compute the velocity's standard errors (statistics/covariance.hpp with
+  // the kernel weights, homoscedastic).
+  bool standard_errors = true;
+};
+
+template <class G>
+struct LocalEstimate {
+  using Scalar = typename G::Scalar;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+
+  Scalar covariate = 0;                      // tau
+  Status status = Status::invalid_input;     // of the local fit
+  std::string message;                       // why, when not ok()
+  Element pose = G::identity();              // gamma_tau(tau)
+  Tangent velocity = Tangent::Zero();        // body velocity per covariate unit
+  Tangent velocity_error = Tangent::Zero();  // its standard errors (0 if undefined)
+  bool velocity_error_defined = false;
+  int iterations = 0;      // Gauss-Newton iterations of the local fit
+  std::size_t window = 0;  // observations with positive weight
+
+  bool ok() const { return is_success(status); }
+};
+
+template <class G>
+class LocalGeodesicRegression {
+  static_assert(check_lie_group<G>());
+
+ public:
+  using Scalar = typename G::Scalar;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+  using Options = LocalRegressionOptions<Scalar>;
+  using Estimate = LocalEstimate<G>;
+
+  explicit LocalGeodesicRegression(Options options) : options_(std::move(options)) {}
+  const Options& options() const { return options_; }
+
+  // Estimates at every observation's covariate, in input order.
+  template <class Observations, class Covariates>
+  std::vector<Estimate> smooth(const Observations& observations,
+                               const Covariates& covariates) const {
+    std::vector<Scalar> queries(covariates.size());
+    for (std::size_t i = 0; i < queries.size(); ++i)
+      queries[i] = Scalar(covariates[i]);
+    return smooth_at(observations, covariates, queries);
+  }
+
+  // Estimates at `queries` (any order, any values), in the queries' order.
+  // A query outside the data's range extrapolates along its window's
+  // geodesic. Never throws for bad input, never NaN: a refused input or a
+  // window with fewer than two distinct covariates is reported per query.
+  template <class Observations, class Covariates>
+  std::vector<Estimate> smooth_at(const Observations& observations, const Covariates& covariates,
+                                  const std::vector<Scalar>& queries) const {
+    std::vector<Estimate> estimates(queries.size());
+    for (std::size_t q = 0; q < queries.size(); ++q)
+      estimates[q].covariate = queries[q];
+    if (const std::string refusal = check(observations, covariates, queries); !refusal.empty()) {
+      for (Estimate& estimate : estimates)
+        estimate.message = refusal;
+      return estimates;
+    }
+
+    // Sorted once: the covariates ascending, the observations alongside.
+    const std::size_t n = observations.size();
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return Scalar(covariates[a]) < Scalar(covariates[b]);
+    });
+    std::vector<Scalar> sorted_t(n);
+    std::vector<Element> sorted_f(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      sorted_t[i] = Scalar(covariates[order[i]]);
+      sorted_f[i] = observations[order[i]];
+    }
+    std::vector<std::size_t> query_order(queries.size());
+    std::iota(query_order.begin(), query_order.end(), std::size_t(0));
+    std::stable_sort(query_order.begin(), query_order.end(),
+                     [&](std::size_t a, std::size_t b) { return queries[a] < queries[b]; });
+
+    const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
+    Window window;
+    window.reserve(n);
+    std::optional<Geodesic<G>> previous;
+    for (const std::size_t q : query_order) {
+      const Scalar tau = queries[q];
+      fill_window(sorted_f, sorted_t, tau, reach, window);
+      estimates[q] = estimate_at(tau, window, previous);
+    }
+    return estimates;
+  }
+
+ private:
+  struct Window {
+    std::vector<Element> observations;
+    std::vector<Scalar> covariates;
+    std::vector<Scalar> weights;
+    void reserve(std::size_t n) {
+      observations.reserve(n);
+      covariates.reserve(n);
+      weights.reserve(n);
+    }
+    void clear() {
+      observations.clear();
+      covariates.clear();
+      weights.clear();
+    }
+  };
+
+  template <class Observations, class Covariates>
+  std::string check(const Observations& observations, const Covariates& covariates,
+                    const std::vector<Scalar>& queries) const {
+    using std::isfinite;
+    if (!(options_.bandwidth > 0) || !isfinite(options_.bandwidth)) {
+      return "the bandwidth must be a finite positive number";
+    }
+    if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
+    if (observations.size() != covariates.size()) {
+      return "observations and covariates differ in length";
+    }
+    for (std::size_t i = 0; i < covariates.size(); ++i) {
+      if (!isfinite(Scalar(covariates[i])))
+        return "covariate " + std::to_string(i) + " is not finite";
+    }
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      if (!isfinite(queries[q])) return "query " + std::to_string(q) + " is not finite";
+    }
+    return {};
+  }
+
+  // The observations with positive kernel weight at tau, ascending.
+  void fill_window(const std::vector<Element>& f, const std::vector<Scalar>& t, Scalar tau,
+                   Scalar reach, Window& window) const {
+    window.clear();
+    const auto first = std::lower_bound(t.begin(), t.end(), tau - reach);
+    const auto last = std::upper_bound(t.begin(), t.end(), tau + reach);
+    for (auto it = first; it != last; ++it) {
+      const std::size_t i = static_cast<std::size_t>(it - t.begin());
+      const Scalar weight = kernel_weight(options_.kernel, (t[i] - tau) / options_.bandwidth);
+      if (!(weight > 0)) continue;
+      window.observations.push_back(f[i]);
+      window.covariates.push_back(t[i]);
+      window.weights.push_back(weight);
+    }
+  }
+
+  Estimate estimate_at(Scalar tau, const Window& window,
+                       std::optional<Geodesic<G>>& previous) const {
+    Estimate estimate;
+    estimate.covariate = tau;
+    estimate.window = window.covariates.size();
+    // Ascending: distinct iff the ends differ.
+    if (window.covariates.empty() || !(window.covariates.back() > window.covariates.front())) {
+      estimate.message = "fewer than two distinct covariates within the kernel's support at " +
+                         std::to_string(double(tau)) + " (" + std::to_string(estimate.window) +
+                         " observations): widen the bandwidth";
+      return estimate;
+    }
+    // The unit interval of the local fit: the window's data.
+    const Scalar start_t = window.covariates.front();
+    const Scalar end_t = window.covariates.back();
+    RegressionOptions<Scalar> fit_options = options_.fit;
+    fit_options.interval = std::make_pair(start_t, end_t);
+    const GeodesicRegression<G> regression(fit_options);
+    const RegressionResult<G> fit =
+        previous ? regression.fit_from({(*previous)(start_t), (*previous)(end_t)},
+                                       window.observations, window.covariates, window.weights)
+                 : regression.fit(window.observations, window.covariates, window.weights);
+    estimate.status = fit.status;
+    estimate.message = fit.message;
+    estimate.iterations = fit.iterations;
+    if (!fit.ok() || !fit.geodesic) return estimate;
+    const Geodesic<G>& local = *fit.geodesic;
+    previous = local;
+    estimate.pose = local(tau);
+    estimate.velocity = local.body_velocity();
+    if (options_.standard_errors) {
+      const FitCovariance<G> c = covariance(fit, window.covariates, window.weights);
+      if (c.defined()) {
+        estimate.velocity_error = standard_errors(velocity_covariance(c));
+        estimate.velocity_error_defined = true;
+      }
+    }
+    return estimate;
+  }
+
+  Options options_;
+};
+
+}  // namespace bireg

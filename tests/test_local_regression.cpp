@@ -1,0 +1,242 @@
+// Local geodesic regression (statistics/local_regression.hpp): textbook
+// local-linear regression on R^n, exact recovery of noise-free geodesics,
+// the global fit as the bandwidth grows, left and right equivariance,
+// independence of the queries' order, real IMU data turning through more
+// than pi, and the reported failure of an empty window.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "bireg/groups/rn.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/io/formats.hpp"
+#include "bireg/regression.hpp"
+#include "bireg/statistics/local_regression.hpp"
+#include "catch.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using R2 = bireg::Rnd<2>;
+using SO3 = bireg::SO3d;
+
+const bireg::Kernel kKernels[] = {bireg::Kernel::gaussian, bireg::Kernel::epanechnikov,
+                                  bireg::Kernel::tricube};
+
+template <class G>
+bireg::LocalRegressionOptions<double> local_options(bireg::Kernel kernel, double bandwidth) {
+  bireg::LocalRegressionOptions<double> options;
+  options.kernel = kernel;
+  options.bandwidth = bandwidth;
+  return options;
+}
+
+// Irregular covariates on [0, 1].
+std::vector<double> irregular_covariates(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<double> t(static_cast<std::size_t>(n));
+  for (double& value : t)
+    value = uniform(rng);
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("On R^2 the local fit is local-linear weighted least squares") {
+  std::mt19937 rng(14);
+  const std::vector<double> t = irregular_covariates(rng, 60);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<R2::Element> f;
+  for (const double ti : t)
+    f.push_back(R2::Element(std::sin(6 * ti) + 0.1 * normal(rng), ti * ti));
+  for (const bireg::Kernel kernel : kKernels) {
+    const bireg::LocalGeodesicRegression<R2> smoother(local_options<R2>(kernel, 0.15));
+    const auto estimates = smoother.smooth(f, t);
+    for (std::size_t q = 0; q < t.size(); ++q) {
+      // min sum w_i |f_i - a - b (t_i - tau)|^2: the 2x2 normal equations.
+      const double tau = t[q];
+      Eigen::Matrix2d normal_matrix = Eigen::Matrix2d::Zero();
+      Eigen::Matrix<double, 2, 2> right = Eigen::Matrix2d::Zero();
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        const double w = bireg::kernel_weight(kernel, (t[i] - tau) / 0.15);
+        const Eigen::Vector2d design(1.0, t[i] - tau);
+        normal_matrix += w * design * design.transpose();
+        right += w * design * f[i].transpose();
+      }
+      const Eigen::Matrix2d solution = normal_matrix.lu().solve(right);
+      INFO("kernel " << bireg::to_string(kernel) << " query " << q);
+      REQUIRE(estimates[q].ok());
+      // Values O(1), N = 60 sums: the two solutions differ by rounding,
+      // ~1e-14; 1e-12 leaves room and catches any wrong weight.
+      CHECK((estimates[q].pose - solution.row(0).transpose()).norm() < 1e-12);
+      CHECK((estimates[q].velocity - solution.row(1).transpose()).norm() < 1e-11);
+    }
+  }
+}
+
+TEST_CASE("Noise-free geodesic data are recovered at every bandwidth") {
+  std::mt19937 rng(7);
+  const std::vector<double> t = irregular_covariates(rng, 80);
+  const SO3::Element g0 = SO3::exp(SO3::Tangent(0.3, -1.2, 0.5));
+  // 2.8 rad over the range: below pi, so every window's displacement is a
+  // principal logarithm (a geodesic turning further is not one Geodesic).
+  const SO3::Tangent velocity(1.5, 1.0, -2.2);
+  std::vector<SO3::Element> f;
+  for (const double ti : t)
+    f.push_back(SO3::compose(g0, SO3::exp(ti * velocity)));
+  for (const bireg::Kernel kernel : kKernels) {
+    for (const double bandwidth : {0.05, 0.2, 1.0, 10.0}) {
+      const bireg::LocalGeodesicRegression<SO3> smoother(local_options<SO3>(kernel, bandwidth));
+      const auto estimates = smoother.smooth(f, t);
+      for (std::size_t q = 0; q < t.size(); ++q) {
+        INFO("kernel " << bireg::to_string(kernel) << " h " << bandwidth << " query " << q);
+        if (!estimates[q].ok()) {
+          // Only a window with a single covariate may fail, and says so.
+          CHECK(estimates[q].window < 2);
+          CHECK(!estimates[q].message.empty());
+          continue;
+        }
+        const SO3::Element truth = SO3::compose(g0, SO3::exp(t[q] * velocity));
+        // Zero residuals: the fit stops at the tolerance 1e-10 with a
+        // quadratically converging step, so its error is rounding, ~1e-14
+        // times the window's condition (range / spread, at most ~1e3 for
+        // the narrowest windows).
+        CHECK(SO3::log(SO3::compose(SO3::inverse(truth), estimates[q].pose)).norm() < 1e-10);
+        CHECK((estimates[q].velocity - velocity).norm() < 1e-10);
+      }
+    }
+  }
+}
+
+TEST_CASE("A bandwidth far past the range gives the global fit") {
+  std::mt19937 rng(3);
+  const std::vector<double> t = irregular_covariates(rng, 50);
+  std::vector<SO3::Element> f;
+  for (const double ti : t) {
+    f.push_back(SO3::exp(SO3::Tangent(ti, 0.5 * ti * ti, -ti) +
+                         bireg_test::random_tangent<SO3::Tangent>(rng, 0.1)));
+  }
+  const bireg::GeodesicRegression<SO3> global_regression;
+  const auto global = global_regression.fit(f, t);
+  REQUIRE(global.ok());
+  // h = 1e8 ranges: 1 - K(u) <= 1e-16 / 2 for the Gaussian, 1e-16 for the
+  // others, below the weights' rounding, so the local fit is the global one
+  // up to the convergence tolerance (1e-10 on the step, quadratically: ~0).
+  for (const bireg::Kernel kernel : kKernels) {
+    const bireg::LocalGeodesicRegression<SO3> smoother(local_options<SO3>(kernel, 1e8));
+    const std::vector<double> middle{0.5};
+    const auto estimates = smoother.smooth_at(f, t, middle);
+    REQUIRE(estimates[0].ok());
+    const SO3::Element expected = (*global.geodesic)(0.5);
+    CHECK(SO3::log(SO3::compose(SO3::inverse(expected), estimates[0].pose)).norm() < 1e-12);
+    CHECK((estimates[0].velocity - global.geodesic->body_velocity()).norm() < 1e-11);
+  }
+}
+
+TEST_CASE("Left and right translation move poses and map velocities by Ad") {
+  std::mt19937 rng(21);
+  const std::vector<double> t = irregular_covariates(rng, 70);
+  std::vector<SO3::Element> f;
+  for (const double ti : t) {
+    f.push_back(SO3::exp(SO3::Tangent(3 * ti, std::sin(5 * ti), -ti) +
+                         bireg_test::random_tangent<SO3::Tangent>(rng, 0.05)));
+  }
+  const SO3::Element left = SO3::exp(SO3::Tangent(1.0, -2.0, 0.7));
+  const SO3::Element right = SO3::exp(SO3::Tangent(-0.4, 0.9, 2.2));
+  std::vector<SO3::Element> moved;
+  for (const auto& fi : f)
+    moved.push_back(SO3::compose(SO3::compose(left, fi), right));
+  const bireg::LocalGeodesicRegression<SO3> smoother(
+      local_options<SO3>(bireg::Kernel::tricube, 0.12));
+  const auto original = smoother.smooth(f, t);
+  const auto translated = smoother.smooth(moved, t);
+  const SO3::AdMatrix ad_right_inverse = SO3::Ad(SO3::inverse(right));
+  for (std::size_t q = 0; q < t.size(); ++q) {
+    INFO("query " << q);
+    REQUIRE(original[q].ok());
+    REQUIRE(translated[q].ok());
+    const SO3::Element expected = SO3::compose(SO3::compose(left, original[q].pose), right);
+    // Rounding of the translated data (~1e-16) amplified by the windows'
+    // conditioning and Gauss-Newton stopping at 1e-10: 1e-10.
+    CHECK(SO3::log(SO3::compose(SO3::inverse(expected), translated[q].pose)).norm() < 1e-10);
+    CHECK((translated[q].velocity - ad_right_inverse * original[q].velocity).norm() < 1e-10);
+    CHECK(translated[q].iterations <= 6);
+  }
+}
+
+TEST_CASE("The result does not depend on the queries' order") {
+  std::mt19937 rng(5);
+  const std::vector<double> t = irregular_covariates(rng, 60);
+  std::vector<SO3::Element> f;
+  for (const double ti : t) {
+    f.push_back(SO3::exp(SO3::Tangent(4 * ti, std::cos(3 * ti), 0.2) +
+                         bireg_test::random_tangent<SO3::Tangent>(rng, 0.05)));
+  }
+  std::vector<double> queries;
+  for (int k = 0; k <= 40; ++k)
+    queries.push_back(k / 40.0);
+  std::vector<double> shuffled = queries;
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  const bireg::LocalGeodesicRegression<SO3> smoother(
+      local_options<SO3>(bireg::Kernel::gaussian, 0.05));
+  const auto in_order = smoother.smooth_at(f, t, queries);
+  const auto out_of_order = smoother.smooth_at(f, t, shuffled);
+  for (std::size_t k = 0; k < shuffled.size(); ++k) {
+    const std::size_t q = static_cast<std::size_t>(std::lround(shuffled[k] * 40.0));
+    REQUIRE(in_order[q].ok());
+    REQUIRE(out_of_order[k].covariate == in_order[q].covariate);
+    CHECK(SO3::log(SO3::compose(SO3::inverse(in_order[q].pose), out_of_order[k].pose)).norm() <
+          1e-12);
+    CHECK((in_order[q].velocity - out_of_order[k].velocity).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("x-IMU orientation turning through more than pi is smoothed without failure") {
+  std::ifstream in(BIREG_TEST_DATA_DIR "/xio_imu_orientation_slice.csv");
+  REQUIRE(in);
+  bireg::io::Trajectory<SO3> data;
+  REQUIRE(!bireg::io::read_trajectory<SO3>(in, bireg::io::Format::matrix, data));
+  REQUIRE(data.observations.size() == 400);
+  double turned = 0;
+  for (std::size_t i = 1; i < data.observations.size(); ++i) {
+    turned +=
+        SO3::log(SO3::compose(SO3::inverse(data.observations[i - 1]), data.observations[i])).norm();
+  }
+  REQUIRE(turned > 3.1416);
+  for (const bireg::Kernel kernel : kKernels) {
+    // 3 samples at 128 Hz.
+    const bireg::LocalGeodesicRegression<SO3> smoother(local_options<SO3>(kernel, 3.0 / 128));
+    const auto estimates = smoother.smooth(data.observations, data.covariates);
+    int iterations = 0;
+    for (const auto& estimate : estimates) {
+      INFO(estimate.message);
+      REQUIRE(estimate.ok());
+      CHECK(estimate.velocity_error_defined);
+      iterations += estimate.iterations;
+    }
+    // Warm starts on smooth data: a few Gauss-Newton iterations per query.
+    CHECK(iterations <= 4 * static_cast<int>(estimates.size()));
+  }
+}
+
+TEST_CASE("A window with fewer than two covariates is reported, never NaN") {
+  const std::vector<double> t{0.0, 0.1, 5.0};
+  const std::vector<SO3::Element> f{SO3::identity(), SO3::exp(SO3::Tangent(0.1, 0, 0)),
+                                    SO3::exp(SO3::Tangent(0, 0.1, 0))};
+  const bireg::LocalGeodesicRegression<SO3> smoother(
+      local_options<SO3>(bireg::Kernel::epanechnikov, 0.5));
+  const auto estimates = smoother.smooth(f, t);
+  CHECK(estimates[0].ok());
+  CHECK(estimates[1].ok());
+  CHECK(!estimates[2].ok());
+  CHECK(estimates[2].status == bireg::Status::invalid_input);
+  CHECK(estimates[2].message.find("fewer than two distinct covariates") != std::string::npos);
+  CHECK(estimates[2].velocity.allFinite());
+  const bireg::LocalGeodesicRegression<SO3> bad(local_options<SO3>(bireg::Kernel::gaussian, -1));
+  CHECK(bad.smooth(f, t)[0].message.find("bandwidth") != std::string::npos);
+}
