@@ -32,20 +32,20 @@ void operator delete(void* p, std::size_t) noexcept {
 
 namespace {
 
-// Observations scattered about a geodesic: exp(i/49 x + noise), x and the
+// Observations scattered about a geodesic: exp(i/(n - 1) x + noise), x and the
 // noise uniform in [-1, 1] and [-0.1, 0.1] per coordinate.
 template <class G>
-void make_observations(std::vector<typename G::Element>& f, std::vector<double>& t) {
+void make_observations(std::vector<typename G::Element>& f, std::vector<double>& t, int n = 50) {
   std::mt19937 rng(71);
   std::uniform_real_distribution<double> uniform(-1, 1);
   typename G::Tangent x;
   for (int k = 0; k < G::dof; ++k)
     x[k] = uniform(rng);
-  for (int i = 0; i < 50; ++i) {
+  for (int i = 0; i < n; ++i) {
     typename G::Tangent noise;
     for (int k = 0; k < G::dof; ++k)
       noise[k] = 0.1 * uniform(rng);
-    f.push_back(G::exp(i / 49.0 * x + noise));
+    f.push_back(G::exp(i / (n - 1.0) * x + noise));
     t.push_back(i);
   }
 }
@@ -53,8 +53,9 @@ void make_observations(std::vector<typename G::Element>& f, std::vector<double>&
 // Allocations of a fit that runs exactly `iterations` iterations.
 template <class G>
 long fit_allocations(const std::vector<typename G::Element>& f, const std::vector<double>& t,
-                     bireg::Solver solver, int iterations) {
+                     bireg::Solver solver, int iterations, int threads = 1) {
   typename bireg::GeodesicRegression<G>::Options options;
+  options.threads = threads;
   options.solver = solver;
   options.max_iterations = iterations;
   options.tolerance = 0;  // run every iteration
@@ -79,6 +80,22 @@ TEMPLATE_TEST_CASE("the solver loop does not allocate", "[allocation]", bireg::S
     CAPTURE(bireg::to_string(solver));
     const long one = fit_allocations<G>(f, t, solver, 1);
     const long forty = fit_allocations<G>(f, t, solver, 40);
+    REQUIRE(forty == one);
+  }
+}
+
+// With threads, the pool and the chunk partials are made once per fit: a
+// fit spanning several chunks on 2 threads also allocates as often for 40
+// iterations as for 1.
+TEST_CASE("the threaded solver loop does not allocate", "[allocation]") {
+  using G = bireg::SE3<double>;
+  std::vector<typename G::Element> f;
+  std::vector<double> t;
+  make_observations<G>(f, t, 3 * static_cast<int>(bireg::kChunkSize));
+  for (const int threads : {1, 2}) {
+    CAPTURE(threads);
+    const long one = fit_allocations<G>(f, t, bireg::Solver::gauss_newton, 1, threads);
+    const long forty = fit_allocations<G>(f, t, bireg::Solver::gauss_newton, 40, threads);
     REQUIRE(forty == one);
   }
 }

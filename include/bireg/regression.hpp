@@ -48,6 +48,7 @@
 #include "bireg/regression/estimating_equations.hpp"
 #include "bireg/regression/iteration.hpp"
 #include "bireg/regression/options.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/result.hpp"
 #include "bireg/regression/solver.hpp"
@@ -155,8 +156,13 @@ class GeodesicRegression {
                                              options_.record_iterates};
       Result result;
       IterationRecord<G> record;
-      const State<G> state = iterate<G>(observations, problem, psi, rule, control, first.first,
-                                        first.second, chart.reference, result.residuals, record);
+      // The pool lives as long as this fit and serves every evaluation.
+      std::optional<ChunkPool> pool;
+      if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads);
+      ForceWorkspace<G> workspace(pool ? &*pool : nullptr, n);
+      const State<G> state =
+          iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
+                     chart.reference, result.residuals, record, &workspace);
       if (!state.series_converges) {  // no force was evaluated there: residuals alone
         const Element g0_inverse = G::inverse(state.g0);
         for (std::size_t i = 0; i < n; ++i) {

@@ -11,6 +11,7 @@
 // (v0, v1).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -23,6 +24,7 @@
 #include "bireg/geodesic.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/psi_series.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/status.hpp"
 
@@ -59,6 +61,21 @@ struct State {
   bool usable() const { return series_converges && force.v0.allFinite() && force.v1.allFinite(); }
 };
 
+// Where the force's chunk sums run (parallel.hpp): a pool, or none for the
+// calling thread alone, and the per-chunk partial sums a pool writes,
+// sized once per fit so that no evaluation allocates.
+template <class G>
+struct ForceWorkspace {
+  static constexpr std::size_t kMomentsPerChunk = 2 * (kMaxSeriesOrder + 2);
+  ChunkPool* pool = nullptr;
+  std::vector<typename G::Tangent> partials;
+
+  ForceWorkspace() = default;
+  ForceWorkspace(ChunkPool* chunk_pool, std::size_t n) : pool(chunk_pool) {
+    if (pool) partials.resize(chunk_count(n) * kMomentsPerChunk);
+  }
+};
+
 // r_i = log(b_i^{-1} f_i), the residual of one observation at the
 // prediction b_i = g0 exp(t_i X), with b_i^{-1} = exp(-t_i X) g0^{-1}.
 template <class G>
@@ -81,27 +98,66 @@ template <class G, class Observations>
 Force<G> series_force(const Observations& observations, const Problem<typename G::Scalar>& problem,
                       const typename G::Element& g0, const typename G::Tangent& x,
                       const typename G::AdMatrix& a, int order,
-                      std::vector<typename G::Tangent>& residuals) {
+                      std::vector<typename G::Tangent>& residuals, ForceWorkspace<G>* workspace) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
-  std::array<Tangent, kMaxSeriesOrder + 2> p, q;  // P_j, Q_j for j = 1 .. order + 1
-  for (int j = 1; j <= order + 1; ++j) {
-    p[j].setZero();
-    q[j].setZero();
-  }
+  using Moments = std::array<Tangent, kMaxSeriesOrder + 2>;
   const typename G::Element g0_inverse = G::inverse(g0);
-  const std::size_t n = observations.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Scalar t = problem.t[i];
-    const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
-    residuals[i] = r;
-    Scalar t_power = problem.w[i];
-    Scalar one_minus_t_power = problem.w[i];
+  // P_j, Q_j (j = 1 .. order + 1) of observations [begin, end), from zero.
+  const auto accumulate = [&](std::size_t begin, std::size_t end, Tangent* p, Tangent* q) {
     for (int j = 1; j <= order + 1; ++j) {
-      t_power *= t;
-      one_minus_t_power *= 1 - t;
-      p[j] += t_power * r;
-      q[j] += one_minus_t_power * r;
+      p[j].setZero();
+      q[j].setZero();
+    }
+    for (std::size_t i = begin; i < end; ++i) {
+      const Scalar t = problem.t[i];
+      const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
+      residuals[i] = r;
+      Scalar t_power = problem.w[i];
+      Scalar one_minus_t_power = problem.w[i];
+      for (int j = 1; j <= order + 1; ++j) {
+        t_power *= t;
+        one_minus_t_power *= 1 - t;
+        p[j] += t_power * r;
+        q[j] += one_minus_t_power * r;
+      }
+    }
+  };
+  Moments p, q;
+  const std::size_t n = observations.size();
+  const std::size_t chunks = chunk_count(n);
+  if (chunks <= 1) {
+    accumulate(0, n, p.data(), q.data());
+  } else {
+    // Chunk partial sums added in chunk order (parallel.hpp): the same
+    // arithmetic whether a pool computed them or this loop did.
+    const auto chunk_end = [&](std::size_t chunk) { return std::min(n, (chunk + 1) * kChunkSize); };
+    const auto combine = [&](const Tangent* chunk_p, const Tangent* chunk_q) {
+      for (int j = 1; j <= order + 1; ++j) {
+        p[j] += chunk_p[j];
+        q[j] += chunk_q[j];
+      }
+    };
+    for (int j = 1; j <= order + 1; ++j) {
+      p[j].setZero();
+      q[j].setZero();
+    }
+    if (workspace && workspace->pool) {
+      constexpr std::size_t stride = ForceWorkspace<G>::kMomentsPerChunk;
+      Tangent* partials = workspace->partials.data();
+      workspace->pool->run(chunks, [&](std::size_t chunk) {
+        Tangent* chunk_p = partials + chunk * stride;
+        accumulate(chunk * kChunkSize, chunk_end(chunk), chunk_p, chunk_p + stride / 2);
+      });
+      for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+        combine(partials + chunk * stride, partials + chunk * stride + stride / 2);
+      }
+    } else {
+      Moments chunk_p, chunk_q;
+      for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+        accumulate(chunk * kChunkSize, chunk_end(chunk), chunk_p.data(), chunk_q.data());
+        combine(chunk_p.data(), chunk_q.data());
+      }
     }
   }
   const auto series_term = [&](const std::array<Tangent, kMaxSeriesOrder + 2>& moments, int m) {
@@ -125,7 +181,8 @@ template <class G, class Observations>
 Force<G> closed_form_force(const Observations& observations,
                            const Problem<typename G::Scalar>& problem,
                            const typename G::Element& g0, const typename G::Tangent& x,
-                           std::vector<typename G::Tangent>& residuals) {
+                           std::vector<typename G::Tangent>& residuals,
+                           ForceWorkspace<G>* workspace) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
   using Psi = typename G::ClosedFormPsi;
@@ -133,16 +190,44 @@ Force<G> closed_form_force(const Observations& observations,
   const auto forward = Psi::prepare(x);
   const auto backward = Psi::prepare(-x);
   const typename G::Element g0_inverse = G::inverse(g0);
-  Force<G> force{Tangent::Zero(), Tangent::Zero()};
+  // The force of observations [begin, end), from zero.
+  const auto accumulate = [&](std::size_t begin, std::size_t end) {
+    Force<G> force{Tangent::Zero(), Tangent::Zero()};
+    for (std::size_t i = begin; i < end; ++i) {
+      const Scalar t = problem.t[i], w = problem.w[i];
+      const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
+      residuals[i] = r;
+      const SinCos t_half = SinCos::of(t * forward.theta / 2);
+      const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
+      force.v0 += w * Psi::apply(backward, 1 - t, u_half, t_half, r);
+      force.v1 += w * Psi::apply(forward, t, t_half, u_half, r);
+    }
+    return force;
+  };
   const std::size_t n = observations.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Scalar t = problem.t[i], w = problem.w[i];
-    const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
-    residuals[i] = r;
-    const SinCos t_half = SinCos::of(t * forward.theta / 2);
-    const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
-    force.v0 += w * Psi::apply(backward, 1 - t, u_half, t_half, r);
-    force.v1 += w * Psi::apply(forward, t, t_half, u_half, r);
+  const std::size_t chunks = chunk_count(n);
+  if (chunks <= 1) return accumulate(0, n);
+  // Chunk partial sums added in chunk order (parallel.hpp).
+  const auto chunk_end = [&](std::size_t chunk) { return std::min(n, (chunk + 1) * kChunkSize); };
+  Force<G> force{Tangent::Zero(), Tangent::Zero()};
+  if (workspace && workspace->pool) {
+    Tangent* partials = workspace->partials.data();
+    constexpr std::size_t stride = ForceWorkspace<G>::kMomentsPerChunk;
+    workspace->pool->run(chunks, [&](std::size_t chunk) {
+      const Force<G> part = accumulate(chunk * kChunkSize, chunk_end(chunk));
+      partials[chunk * stride] = part.v0;
+      partials[chunk * stride + 1] = part.v1;
+    });
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      force.v0 += partials[chunk * stride];
+      force.v1 += partials[chunk * stride + 1];
+    }
+  } else {
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      const Force<G> part = accumulate(chunk * kChunkSize, chunk_end(chunk));
+      force.v0 += part.v0;
+      force.v1 += part.v1;
+    }
   }
   return force;
 }
@@ -155,7 +240,8 @@ Force<G> closed_form_force(const Observations& observations,
 template <class G, class Observations>
 State<G> evaluate(const Observations& observations, const Problem<typename G::Scalar>& problem,
                   const PsiEvaluation& psi, const typename G::Element& g0,
-                  const typename G::Element& g1, std::vector<typename G::Tangent>& residuals) {
+                  const typename G::Element& g1, std::vector<typename G::Tangent>& residuals,
+                  ForceWorkspace<G>* workspace = nullptr) {
   using Scalar = typename G::Scalar;
   constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
   State<G> state;
@@ -170,8 +256,8 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
   if constexpr (has_closed_form_psi_v<G>) {
     if (psi.method == Method::exact &&
         G::ClosedFormPsi::angle(state.x) >= static_cast<Scalar>(kExactMinAngle)) {
-      state.force =
-          estimating_detail::closed_form_force<G>(observations, problem, g0, state.x, residuals);
+      state.force = estimating_detail::closed_form_force<G>(observations, problem, g0, state.x,
+                                                            residuals, workspace);
       return state;
     }
   }
@@ -182,7 +268,7 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
         state.a, std::numeric_limits<Scalar>::epsilon(), psi.max_series_order);
   }
   state.force = estimating_detail::series_force<G>(observations, problem, g0, state.x, state.a,
-                                                   state.order, residuals);
+                                                   state.order, residuals, workspace);
   return state;
 }
 

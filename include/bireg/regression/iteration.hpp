@@ -69,7 +69,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
                  const IterationControl<typename G::Scalar>& control,
                  const typename G::Element& start0, const typename G::Element& start1,
                  const typename G::Element& fallback, std::vector<typename G::Tangent>& residuals,
-                 IterationRecord<G>& record) {
+                 IterationRecord<G>& record, ForceWorkspace<G>* workspace = nullptr) {
   using Scalar = typename G::Scalar;
   using std::isfinite;
   using std::sqrt;
@@ -92,12 +92,12 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
 
   int iterations_without_progress = 0;
   Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
-  State<G> state = evaluate<G>(observations, problem, psi, start0, start1, residuals);
+  State<G> state = evaluate<G>(observations, problem, psi, start0, start1, residuals, workspace);
   // A start beyond the series' disc or the log's domain (an extrapolated
   // chart line on a matrix group, a far initial guess): start from the
   // middle observation instead.
   if (!state.usable()) {
-    state = evaluate<G>(observations, problem, psi, fallback, fallback, residuals);
+    state = evaluate<G>(observations, problem, psi, fallback, fallback, residuals, workspace);
   }
   for (int iteration = 0; iteration < control.max_iterations; ++iteration) {
     if (!state.series_converges) {
@@ -131,7 +131,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
     }
 
     State<G> next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, d0),
-                                exp_at<G>(state.g1, d1), trial_residuals);
+                                exp_at<G>(state.g1, d1), trial_residuals, workspace);
     if constexpr (Rule::safeguarded) {
       const Scalar force_norm = state.force.norm();
       const auto acceptable = [&](const State<G>& trial) {
@@ -142,7 +142,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
         fraction /= 2;
         ++record.backtracks;
         next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, fraction * d0),
-                           exp_at<G>(state.g1, fraction * d1), trial_residuals);
+                           exp_at<G>(state.g1, fraction * d1), trial_residuals, workspace);
       }
       // Every halving failed: no step along this direction decreases the
       // force. Above the rounding level that means the data are outside

@@ -51,6 +51,11 @@ struct RegressionOptions {
   Scalar element_tolerance = default_element_tolerance<Scalar>();
   // Keep (g0, g1) after every step in Result::iterates.
   bool record_iterates = false;
+  // Threads summing the force over the observations (parallel.hpp), at
+  // least 1. A fit of more than kParallelMinimum observations starts
+  // threads - 1 workers for its duration; the results are bit-identical
+  // for any value. 1 (the default): no thread is ever started.
+  int threads = 1;
 };
 
 template <class Scalar>
@@ -59,6 +64,9 @@ std::optional<Rejection> validate_options(const RegressionOptions<Scalar>& optio
   const std::string max_order = std::to_string(kMaxSeriesOrder);
   if (!(options.tolerance >= 0) || !isfinite(options.tolerance)) {
     return Rejection{"tolerance must be a finite non-negative number"};
+  }
+  if (options.threads < 1) {
+    return Rejection{"threads must be at least 1, got " + std::to_string(options.threads)};
   }
   if (options.max_iterations < 1) return Rejection{"max_iterations must be at least 1"};
   if (options.max_series_order < 1 || options.max_series_order > kMaxSeriesOrder) {
