@@ -71,7 +71,8 @@ int main() {
   const auto fit1 = bireg::GeodesicRegression<G>(first_order).fit(observations, times);
 
   const G::Tangent start_error = G::log(G::compose(G::inverse(g0), fit.geodesic->start()));
-  const G::Tangent slope = G::log(G::compose(G::inverse(fit.geodesic->start()), fit.geodesic->end()));
+  const G::Tangent slope =
+      G::log(G::compose(G::inverse(fit.geodesic->start()), fit.geodesic->end()));
   const double order_gap =
       G::log(G::compose(G::inverse(fit.geodesic->end()), fit1.geodesic->end())).norm();
   std::printf("%s: status %s after %d iterations, series order %d\n", G::name,

@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "bireg/math/small_angle.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/math/small_angle.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 

@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "bireg/concept.hpp"
-#include "bireg/math/psi_series.hpp"
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/math/matrix_functions.hpp"
+#include "bireg/math/psi_series.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/testing/group_laws.hpp"
 #include "catch.hpp"

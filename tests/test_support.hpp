@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "bireg/testing/group_laws.hpp"
+
 namespace bireg_test {
 
 template <class Scalar>
@@ -27,38 +29,12 @@ Eigen::Matrix<long double, D, 1> random_unit(std::mt19937& rng) {
   return v / v.norm();
 }
 
-// A random tangent vector with every entry uniform in [-scale, scale].
-template <class Tangent>
-Tangent random_tangent(std::mt19937& rng, double scale) {
-  std::uniform_real_distribution<double> uniform(-scale, scale);
-  Tangent x;
-  for (int i = 0; i < x.size(); ++i)
-    x[i] = static_cast<typename Tangent::Scalar>(uniform(rng));
-  return x;
-}
-
-// Matrix exponential in long double by scaling and squaring a Taylor series:
-// the reference for exp and Ad(exp) in the tests. It uses none of the
-// library's closed forms. Scaling to norm <= 1/2 and summing until the terms
-// vanish gives ~1e-18 relative accuracy for the moderate norms tested.
-template <int N>
-Eigen::Matrix<long double, N, N> reference_expm(const Eigen::Matrix<long double, N, N>& a) {
-  using Matrix = Eigen::Matrix<long double, N, N>;
-  const long double norm = a.cwiseAbs().rowwise().sum().maxCoeff();
-  int squarings = 0;
-  while (std::ldexp(norm, -squarings) > 0.5L)
-    ++squarings;
-  const Matrix scaled = a * std::ldexp(1.0L, -squarings);
-  Matrix sum = Matrix::Identity();
-  Matrix term = Matrix::Identity();
-  for (int k = 1; k < 40; ++k) {
-    term = term * scaled / static_cast<long double>(k);
-    sum += term;
-  }
-  for (int i = 0; i < squarings; ++i)
-    sum = sum * sum;
-  return sum;
-}
+// Random tangent vectors (entries uniform in [-scale, scale]) and the long
+// double matrix exponential (scaling and squaring a Taylor series; it uses
+// none of the library's closed forms): the ones users get from
+// bireg/testing/group_laws.hpp.
+using bireg::testing::random_tangent;
+using bireg::testing::reference_expm;
 
 // Rotation matrix of the rotation vector theta * axis (unit axis), built in
 // long double from the unit quaternion (cos(theta/2), sin(theta/2) axis):
@@ -79,10 +55,7 @@ inline Eigen::Matrix<long double, 3, 3> reference_rotation(
 // (or 1 if b vanishes): "relative error" of a matrix or vector result.
 template <class A, class B>
 long double relative_error(const A& a, const B& b) {
-  const long double diff =
-      (a.template cast<long double>() - b.template cast<long double>()).cwiseAbs().maxCoeff();
-  const long double scale = b.template cast<long double>().cwiseAbs().maxCoeff();
-  return scale > 0 ? diff / scale : diff;
+  return bireg::testing::relative_difference(a, b);
 }
 
 }  // namespace bireg_test

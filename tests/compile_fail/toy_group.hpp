@@ -33,8 +33,12 @@ struct Toy {
 #endif
   using Algebra = Eigen::Matrix<double, 2, 2>;
 
-  static Element identity() { return Element::Identity(); }
-  static Element compose(const Element& a, const Element& b) { return a * b; }
+  static Element identity() {
+    return Element::Identity();
+  }
+  static Element compose(const Element& a, const Element& b) {
+    return a * b;
+  }
 #ifndef BIREG_TOY_NO_INVERSE
   static Element inverse(const Element& g) {
     return g.diagonal().cwiseInverse().asDiagonal();
@@ -59,15 +63,19 @@ struct Toy {
     return x;
   }
 #if !defined(BIREG_TOY_NO_ADMATRIX) && !defined(BIREG_TOY_WIDE_ADMATRIX)
-  static AdMatrix ad(const Tangent&) { return AdMatrix::Zero(); }
+  static AdMatrix ad(const Tangent&) {
+    return AdMatrix::Zero();
+  }
 #ifndef BIREG_TOY_NO_AD_OF_ELEMENT
-  static AdMatrix Ad(const Element&) { return AdMatrix::Identity(); }
+  static AdMatrix Ad(const Element&) {
+    return AdMatrix::Identity();
+  }
 #endif
 #endif
 #ifndef BIREG_TOY_NO_IS_ELEMENT
   static bool is_element(const Element& g, Scalar tol) {
-    return g.allFinite() && std::abs(g(0, 1)) <= tol && std::abs(g(1, 0)) <= tol &&
-           g(0, 0) > 0 && g(1, 1) > 0;
+    return g.allFinite() && std::abs(g(0, 1)) <= tol && std::abs(g(1, 0)) <= tol && g(0, 0) > 0 &&
+           g(1, 1) > 0;
   }
 #endif
 };

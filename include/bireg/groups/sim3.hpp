@@ -32,8 +32,8 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "bireg/groups/affine.hpp"
-#include "bireg/groups/so3.hpp"
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/small_angle.hpp"
 
