@@ -24,11 +24,8 @@
 // not converge (the JSON is still printed, with its status), 4 the output
 // could not be written (disk full, closed pipe, ...).
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,17 +36,17 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/io/formats.hpp"
-#include "bireg/io/line_reader.hpp"
-#include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/robust.hpp"
+#include "cli_common.hpp"
 
 namespace {
 
-constexpr int kExitInvalid = 2;
-constexpr int kExitNotConverged = 3;
-constexpr int kExitWriteError = 4;
+using bireg_cli::kExitInvalid;
+using bireg_cli::kExitNotConverged;
+using bireg_cli::kExitWriteError;
+using bireg_cli::parse_count;
+using bireg_cli::parse_number;
 
 constexpr const char* kUsage =
     "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]\n"
@@ -63,9 +60,7 @@ constexpr const char* kUsage =
 
 struct Command {
   std::string group;
-  std::optional<bireg::io::Format> format;  // empty: detect
-  std::string times;
-  bool project = false;
+  bireg_cli::InputOptions input;
   bireg::Method method = bireg::Method::exact;
   int order = 0;
   bireg::Solver solver = bireg::Solver::gauss_newton;
@@ -74,7 +69,6 @@ struct Command {
   int max_iterations = 1000;
   std::string output_trajectory;
   std::optional<bireg::io::Format> output_format;  // empty: the input's
-  std::string input;
   std::optional<bireg::Loss> loss;
   double loss_scale = 0;  // 0: the 95%-efficiency default
 };
@@ -82,19 +76,6 @@ struct Command {
 int fail(const std::string& message) {
   std::fprintf(stderr, "bireg_fit: %s\n", message.c_str());
   return kExitInvalid;
-}
-
-bool parse_number(const std::string& text, double& value) {
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
-}
-
-bool parse_count(const std::string& text, int& value) {
-  double x = 0;
-  if (!parse_number(text, x) || x != std::floor(x) || x < 0 || x > 1e9) return false;
-  value = static_cast<int>(x);
-  return true;
 }
 
 // Parses argv into `command`; returns an error message or nothing.
@@ -107,12 +88,12 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       return std::string(argv[++i]);
     };
     if (arg == "-" || arg.empty() || arg[0] != '-') {
-      if (!command.input.empty()) return "more than one input file";
-      command.input = arg;
+      if (!command.input.path.empty()) return "more than one input file";
+      command.input.path = arg;
       continue;
     }
     if (arg == "--project") {
-      command.project = true;
+      command.input.project = true;
       continue;
     }
     const std::optional<std::string> v = value();
@@ -120,13 +101,12 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     if (arg == "--group") {
       command.group = *v;
     } else if (arg == "--format" || arg == "--output-format") {
-      const auto format = bireg::io::format_from_string(*v);
-      if (!format) {
-        return "unknown format " + bireg::io::quote_excerpt(*v) + " (matrix, tum, euroc or kitti)";
+      if (auto error = bireg_cli::parse_format(
+              *v, arg == "--format" ? command.input.format : command.output_format)) {
+        return error;
       }
-      (arg == "--format" ? command.format : command.output_format) = format;
     } else if (arg == "--times") {
-      command.times = *v;
+      command.input.times = *v;
     } else if (arg == "--method") {
       bool known = false;
       for (bireg::Method method :
@@ -186,10 +166,7 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   if (command.output_format && command.output_trajectory.empty()) {
     return "--output-format goes with --output-trajectory FILE";
   }
-  if (!command.times.empty() && command.format && *command.format != bireg::io::Format::kitti) {
-    return "--times goes with the kitti format";
-  }
-  if (command.input.empty()) return "no input file (use - for standard input)";
+  if (auto error = bireg_cli::check_input_options(command.input)) return error;
   if (command.method == bireg::Method::series && !order_given)
     return "--method series needs --order M";
   if (command.method != bireg::Method::series && order_given) {
@@ -201,62 +178,18 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
 
 using bireg::io::json_number;
 
-// Opens `path` ("-": standard input) for reading as a C stream, or says why
-// not (a directory is refused by name: reading it would fail with EISDIR).
-std::FILE* open_input(const std::string& path, const std::string& name, std::string& problem) {
-  if (path == "-") return stdin;
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    problem = name + ": is a directory, not a file";
-    return nullptr;
-  }
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) problem = name + ": cannot open file (" + std::strerror(errno) + ")";
-  return file;
-}
-
-std::string where(const std::string& name, std::uint64_t line) {
-  return line > 0 ? name + ":" + std::to_string(line) : name;
-}
-
 template <class G>
 int run(const Command& command) {
   using Regression = bireg::GeodesicRegression<G>;
   namespace io = bireg::io;
-  const std::string name = command.input == "-" ? "<stdin>" : command.input;
+  const std::string name = bireg_cli::display_name(command.input.path);
   if (command.output_format && !io::supports<G>(*command.output_format)) {
     return fail(std::string("the ") + io::to_string(*command.output_format) +
                 " format holds SE3 or SO3 poses, not " + G::name);
   }
 
-  io::ReadOptions read_options;
-  read_options.format = command.format;
-  read_options.project = command.project;
-  std::vector<io::Timestamp> times;
-  std::string problem;
-  if (!command.times.empty()) {
-    std::FILE* file = open_input(command.times, command.times, problem);
-    if (!file) return fail(problem);
-    io::FileSource source(file);
-    const auto error = io::read_times(source, times);
-    if (file != stdin) std::fclose(file);
-    if (error) return fail(where(command.times, error->line) + ": " + error->message);
-    read_options.times = &times;
-  }
-
   io::Trajectory<G> trajectory;
-  {
-    std::FILE* file = open_input(command.input, name, problem);
-    if (!file) return fail(problem);
-    io::FileSource source(file);
-    const auto error = io::read_trajectory<G>(source, read_options, trajectory);
-    if (file != stdin) std::fclose(file);
-    if (error) return fail(where(name, error->line) + ": " + error->message);
-  }
-  if (!command.times.empty() && trajectory.format != io::Format::kitti) {
-    return fail(name + ": --times goes with the kitti format, and the input reads as " +
-                io::to_string(trajectory.format));
-  }
+  if (auto error = bireg_cli::read_input<G>(command.input, trajectory)) return fail(*error);
 
   typename Regression::Options options;
   options.method = command.method;
@@ -283,7 +216,7 @@ int run(const Command& command) {
   if (result.status == bireg::Status::invalid_input) {
     const std::uint64_t line =
         result.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(result.bad_index)] : 0;
-    return fail(where(name, line) + ": " + result.message);
+    return fail(bireg_cli::where(name, line) + ": " + result.message);
   }
 
   if (!command.output_trajectory.empty()) {
@@ -292,30 +225,19 @@ int run(const Command& command) {
     fitted.reserve(trajectory.covariates.size());
     for (double t : trajectory.covariates)
       fitted.push_back((*result.geodesic)(t));
-    std::FILE* out = std::fopen(command.output_trajectory.c_str(), "wb");
-    if (!out) {
-      std::fprintf(stderr, "bireg_fit: %s: cannot write file (%s)\n",
-                   command.output_trajectory.c_str(), std::strerror(errno));
-      return kExitWriteError;
-    }
-    auto error =
-        io::write_trajectory<G>(out, format, trajectory.format, trajectory.timestamps, fitted);
-    errno = 0;
-    if (std::fclose(out) != 0 && !error) {
-      error = std::string("write error: ") + std::strerror(errno);
-    }
-    if (error) {
-      std::fprintf(stderr, "bireg_fit: %s: %s\n", command.output_trajectory.c_str(),
-                   error->c_str());
+    if (auto error = bireg_cli::write_output<G>(command.output_trajectory, format,
+                                                trajectory.format, trajectory.timestamps, fitted)) {
+      std::fprintf(stderr, "bireg_fit: %s\n", error->c_str());
       return kExitWriteError;
     }
   }
 
   const auto& d = result.diagnostics;
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
-  const std::string projection = command.project ? ", \"projection_correction\": " +
-                                                       json_number(trajectory.projection_correction)
-                                                 : std::string();
+  const std::string projection =
+      command.input.project
+          ? ", \"projection_correction\": " + json_number(trajectory.projection_correction)
+          : std::string();
   std::printf(
       "{\"group\": \"%s\", \"format\": \"%s\", \"n\": %zu%s,\n \"g0\": %s,\n \"g1\": %s,\n"
       " \"t_min\": %s, \"t_max\": %s,\n"

@@ -1,0 +1,147 @@
+// What bireg's command-line tools share: number and option parsing with the
+// same spelling and messages, opening input ("-" is standard input),
+// reading a trajectory file with its --times file, writing a trajectory
+// file, and the exit codes. Not part of the installed library: the tools
+// (bireg_fit, bireg_smooth) include it from tools/.
+#pragma once
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bireg/io/formats.hpp"
+#include "bireg/io/line_reader.hpp"
+#include "bireg/io/writers.hpp"
+
+namespace bireg_cli {
+
+constexpr int kExitInvalid = 2;       // invalid input or usage
+constexpr int kExitNotConverged = 3;  // a fit did not converge (output still written)
+constexpr int kExitWriteError = 4;    // output could not be written
+
+// A finite number spelt entirely by `text` (strtod's syntax).
+inline bool parse_number(const std::string& text, double& value) {
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+// A non-negative integer up to 1e9.
+inline bool parse_count(const std::string& text, int& value) {
+  double x = 0;
+  if (!parse_number(text, x) || x != std::floor(x) || x < 0 || x > 1e9) return false;
+  value = static_cast<int>(x);
+  return true;
+}
+
+// The value of --format / --output-format, or the message naming the choices.
+inline std::optional<std::string> parse_format(const std::string& text,
+                                               std::optional<bireg::io::Format>& format) {
+  format = bireg::io::format_from_string(text);
+  if (format) return std::nullopt;
+  return "unknown format " + bireg::io::quote_excerpt(text) + " (matrix, tum, euroc or kitti)";
+}
+
+// The input file's name as messages show it.
+inline std::string display_name(const std::string& path) {
+  return path == "-" ? "<stdin>" : path;
+}
+
+// "name:line", or just the name for a problem with the whole file.
+inline std::string where(const std::string& name, std::uint64_t line) {
+  return line > 0 ? name + ":" + std::to_string(line) : name;
+}
+
+// Opens `path` ("-": standard input) for reading as a C stream, or says why
+// not (a directory is refused by name: reading it would fail with EISDIR).
+inline std::FILE* open_input(const std::string& path, std::string& problem) {
+  if (path == "-") return stdin;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    problem = display_name(path) + ": is a directory, not a file";
+    return nullptr;
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) problem = display_name(path) + ": cannot open file (" + std::strerror(errno) + ")";
+  return file;
+}
+
+// How to read the input trajectory: the options the tools share.
+struct InputOptions {
+  std::string path;                         // "-": standard input
+  std::optional<bireg::io::Format> format;  // empty: detect by content
+  std::string times;                        // KITTI's times.txt, or empty
+  bool project = false;                     // re-orthonormalise rotations
+};
+
+// Consistency of the shared input options, checked after parsing.
+inline std::optional<std::string> check_input_options(const InputOptions& input) {
+  if (!input.times.empty() && input.format && *input.format != bireg::io::Format::kitti) {
+    return "--times goes with the kitti format";
+  }
+  if (input.path.empty()) return "no input file (use - for standard input)";
+  return std::nullopt;
+}
+
+// Reads the trajectory (and its --times file); returns the one-line message
+// naming file and line when the input is invalid.
+template <class G>
+std::optional<std::string> read_input(const InputOptions& input,
+                                      bireg::io::Trajectory<G>& trajectory) {
+  namespace io = bireg::io;
+  io::ReadOptions read_options;
+  read_options.format = input.format;
+  read_options.project = input.project;
+  std::vector<io::Timestamp> times;
+  std::string problem;
+  if (!input.times.empty()) {
+    std::FILE* file = open_input(input.times, problem);
+    if (!file) return problem;
+    io::FileSource source(file);
+    const auto error = io::read_times(source, times);
+    if (file != stdin) std::fclose(file);
+    if (error) return where(display_name(input.times), error->line) + ": " + error->message;
+    read_options.times = &times;
+  }
+  const std::string name = display_name(input.path);
+  std::FILE* file = open_input(input.path, problem);
+  if (!file) return problem;
+  io::FileSource source(file);
+  const auto error = io::read_trajectory<G>(source, read_options, trajectory);
+  if (file != stdin) std::fclose(file);
+  if (error) return where(name, error->line) + ": " + error->message;
+  if (!input.times.empty() && trajectory.format != io::Format::kitti) {
+    return name + ": --times goes with the kitti format, and the input reads as " +
+           io::to_string(trajectory.format);
+  }
+  return std::nullopt;
+}
+
+// Writes `poses` at `timestamps` to `path` ("-": standard output) in
+// `format`, timestamps rendered as the `source` format wrote them. Returns
+// "path: reason" when the file cannot be written.
+template <class G>
+std::optional<std::string> write_output(const std::string& path, bireg::io::Format format,
+                                        bireg::io::Format source,
+                                        const std::vector<bireg::io::Timestamp>& timestamps,
+                                        const std::vector<typename G::Element>& poses) {
+  const bool to_stdout = path == "-";
+  const std::string name = to_stdout ? "<stdout>" : path;
+  std::FILE* out = to_stdout ? stdout : std::fopen(path.c_str(), "wb");
+  if (!out) return name + ": cannot write file (" + std::strerror(errno) + ")";
+  auto error = bireg::io::write_trajectory<G>(out, format, source, timestamps, poses);
+  errno = 0;
+  const int closed = to_stdout ? std::fflush(out) : std::fclose(out);
+  if (closed != 0 && !error) error = std::string("write error: ") + std::strerror(errno);
+  if (error) return name + ": " + *error;
+  return std::nullopt;
+}
+
+}  // namespace bireg_cli
