@@ -34,7 +34,7 @@ namespace bireg_plot {
 //
 // Edge cases: reversed input is swapped; lo == hi (or a range narrower than
 // 1e-12 of its magnitude, below what doubles resolve for ticks) is widened to
-// the value +- 10% (+- 1 about zero); a non-finite bound, a width that
+// lo +- 10% (+- 1 about zero); a non-finite bound, a width that
 // overflows, or magnitudes beyond 1e+-300 give an empty vector.
 std::vector<double> nice_ticks(double lo, double hi, int target = 5);
 
@@ -189,10 +189,9 @@ inline std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (lo > hi) std::swap(lo, hi);
   const double magnitude = std::max(std::abs(lo), std::abs(hi));
   if (hi - lo <= 1e-12 * magnitude) {
-    const double centre = lo / 2 + hi / 2;
-    const double half = centre != 0 ? 0.1 * std::abs(centre) : 1.0;
-    lo = centre - half;
-    hi = centre + half;
+    const double half = lo != 0 ? 0.1 * std::abs(lo) : 1.0;
+    hi = lo + half;
+    lo -= half;
   }
   const double width = hi - lo;
   target = std::clamp(target, 3, 20);
