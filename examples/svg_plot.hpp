@@ -75,51 +75,54 @@ std::string render_svg(const Figure& figure);
 
 namespace detail {
 
-inline double parse_decimal(long long digits, int exponent) {
-  const std::string text = std::to_string(digits) + "e" + std::to_string(exponent);
-  return std::strtod(text.c_str(), nullptr);
-}
-
-// The fewest significant digits (1..17) that read back as `value`, in %e form.
-inline std::string shortest_scientific(double value) {
-  char buffer[40];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof buffer, "%.*e", digits - 1, value);
-    if (std::strtod(buffer, nullptr) == value) break;
-  }
+// printf into a string; only numbers and fixed markup go through here, text
+// is escaped and appended separately, so 256 characters always suffice.
+template <class... Args>
+std::string format(const char* pattern, Args... args) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, pattern, args...);
   return buffer;
 }
 
+inline double parse_decimal(long long digits, int exponent) {
+  return std::strtod((std::to_string(digits) + "e" + std::to_string(exponent)).c_str(), nullptr);
+}
+
+// `value` in %e form with the fewest significant digits (1..17) that read
+// back as `value`, and those digits' count.
+inline std::string shortest_scientific(double value, int& digits) {
+  std::string text;
+  for (digits = 1; digits <= 17; ++digits) {
+    text = format("%.*e", digits - 1, value);
+    if (std::strtod(text.c_str(), nullptr) == value) break;
+  }
+  return text;
+}
+
 // Labels for one axis, in one notation: fixed with a common number of
-// decimals ("0.5", "1.0", "1.5") unless the values are large or small.
+// decimals ("0.5", "1.0", "1.5") unless the values are large or small, then
+// shortest scientific ("2.5e-7").
 inline std::vector<std::string> format_ticks(const std::vector<double>& ticks) {
   double largest = 0;
-  for (double tick : ticks)
-    largest = std::max(largest, std::abs(tick));
-  const bool scientific = largest >= 1e6 || (largest > 0 && largest < 1e-3);
-  int decimals = 0;
+  int decimals = 0, digits = 0;
   for (double tick : ticks) {
-    const std::string shortest = shortest_scientific(tick);
-    const std::size_t e = shortest.find('e');
-    const bool has_point = shortest.find('.') != std::string::npos;
-    const int digits = static_cast<int>(e) - (tick < 0 ? 1 : 0) - (has_point ? 1 : 0);
-    const int exponent = std::atoi(shortest.c_str() + e + 1);
+    largest = std::max(largest, std::abs(tick));
+    const std::string text = shortest_scientific(tick, digits);
+    const int exponent = std::atoi(text.c_str() + text.find('e') + 1);
     decimals = std::max(decimals, digits - 1 - exponent);
   }
+  const bool scientific = largest >= 1e6 || (largest > 0 && largest < 1e-3);
   std::vector<std::string> labels;
   for (double tick : ticks) {
-    char buffer[64];
-    if (tick == 0) {
-      std::snprintf(buffer, sizeof buffer, scientific ? "0" : "%.*f", decimals, 0.0);
-    } else if (scientific) {  // "2.5e-07" -> "2.5e-7"
-      std::string text = shortest_scientific(tick);
-      const std::size_t e = text.find('e');
-      const int exponent = std::atoi(text.c_str() + e + 1);
-      std::snprintf(buffer, sizeof buffer, "%se%d", text.substr(0, e).c_str(), exponent);
+    if (!scientific) {
+      labels.push_back(format("%.*f", decimals, tick == 0 ? 0.0 : tick));  // no "-0.0"
+    } else if (tick == 0) {
+      labels.emplace_back("0");
     } else {
-      std::snprintf(buffer, sizeof buffer, "%.*f", decimals, tick);
+      const std::string text = shortest_scientific(tick, digits);
+      const std::size_t e = text.find('e');
+      labels.push_back(text.substr(0, e) + "e" + std::to_string(std::atoi(text.c_str() + e + 1)));
     }
-    labels.emplace_back(buffer);
   }
   return labels;
 }
@@ -127,38 +130,32 @@ inline std::vector<std::string> format_ticks(const std::vector<double>& ticks) {
 inline std::string escape(const std::string& text) {
   std::string out;
   for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:  // XML 1.0 forbids control characters other than tab and newlines
-        out += (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n') ? ' ' : c;
+    const unsigned char code = static_cast<unsigned char>(c);
+    if (c == '&' || c == '<' || c == '>' || c == '"' || c == '\'') {
+      out += c == '&'   ? "&amp;"
+             : c == '<' ? "&lt;"
+             : c == '>' ? "&gt;"
+             : c == '"' ? "&quot;"
+                        : "&apos;";
+    } else {  // XML 1.0 forbids control characters other than tab and newline
+      out += code < 0x20 && c != '\t' && c != '\n' ? ' ' : c;
     }
   }
   return out;
 }
 
 inline std::string axis_label(const std::string& label, const std::string& unit) {
-  return unit.empty() ? label : label + " [" + unit + "]";
+  return escape(unit.empty() ? label : label + " [" + unit + "]");
 }
 
+// The finite range of some values; nice ticks over it, [0, 1] if it is empty.
 struct Extent {
   double lo = std::numeric_limits<double>::infinity();
   double hi = -std::numeric_limits<double>::infinity();
-  void add(double v) {
-    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  void add(const std::vector<double>& values) {
+    for (double v : values) {
+      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
   }
   std::vector<double> ticks(int target) const {
     std::vector<double> t = lo <= hi ? nice_ticks(lo, hi, target) : std::vector<double>{};
@@ -166,20 +163,143 @@ struct Extent {
   }
 };
 
-// Data to pixels for one panel's plot area.
-struct Mapping {
-  double x_lo, x_hi, y_lo, y_hi, left, top, width, height;
-  bool pixel(double x, double y, double& px, double& py) const {
-    px = left + (x - x_lo) / (x_hi - x_lo) * width;
-    py = top + (y_hi - y) / (y_hi - y_lo) * height;
-    return std::isfinite(px) && std::isfinite(py);
+// Data to pixels in one panel's plot area, which spans the outer ticks.
+struct Frame {
+  std::vector<double> x_ticks, y_ticks;
+  double left, top, width, height;
+  double px(double x) const {
+    return left + (x - x_ticks.front()) / (x_ticks.back() - x_ticks.front()) * width;
+  }
+  double py(double y) const {
+    return top + (y_ticks.back() - y) / (y_ticks.back() - y_ticks.front()) * height;
+  }
+  // "px,py " or, for a point that does not map to a finite pixel, "".
+  std::string point(double x, double y) const {
+    const double u = px(x), v = py(y);
+    return std::isfinite(u) && std::isfinite(v) ? format("%.2f,%.2f ", u, v) : std::string();
   }
 };
 
-inline std::string point(double px, double py) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.2f,%.2f ", px, py);
-  return buffer;
+inline std::string axes(const Panel& panel, const Frame& frame) {
+  const double right = frame.left + frame.width, bottom = frame.top + frame.height;
+  std::string svg = format("<text x=\"%.0f\" y=\"%.0f\" font-size=\"14\" font-weight=\"bold\">",
+                           frame.left, frame.top - 10) +
+                    escape(panel.title) + "</text>\n";
+  const std::vector<std::string> x_labels = format_ticks(frame.x_ticks);
+  const std::vector<std::string> y_labels = format_ticks(frame.y_ticks);
+  for (std::size_t k = 0; k < x_labels.size(); ++k) {
+    const double x = frame.px(frame.x_ticks[k]);
+    svg += format("<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e4e4e4\"/>\n", x,
+                  frame.top, x, bottom) +
+           format(
+               "<text class=\"tick x\" x=\"%.2f\" y=\"%.2f\" font-size=\"12\" "
+               "text-anchor=\"middle\">",
+               x, bottom + 16) +
+           x_labels[k] + "</text>\n";
+  }
+  for (std::size_t k = 0; k < y_labels.size(); ++k) {
+    const double y = frame.py(frame.y_ticks[k]);
+    svg += format("<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e4e4e4\"/>\n",
+                  frame.left, y, right, y) +
+           format(
+               "<text class=\"tick y\" x=\"%.2f\" y=\"%.2f\" font-size=\"12\" "
+               "text-anchor=\"end\">",
+               frame.left - 6, y + 4) +
+           y_labels[k] + "</text>\n";
+  }
+  const double middle = frame.top + frame.height / 2;
+  return svg +
+         format(
+             "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" "
+             "stroke=\"#888\"/>\n",
+             frame.left, frame.top, frame.width, frame.height) +
+         format("<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">", frame.left + frame.width / 2,
+                bottom + 36) +
+         axis_label(panel.x_label, panel.x_unit) + "</text>\n" +
+         format(
+             "<text x=\"20\" y=\"%.2f\" transform=\"rotate(-90 20 %.2f)\" "
+             "text-anchor=\"middle\">",
+             middle, middle) +
+         axis_label(panel.y_label, panel.y_unit) + "</text>\n";
+}
+
+// One polygon per run of points where x, lower and upper are all finite:
+// along the upper curve, then back along the lower one.
+inline std::string band(const Band& band, const Frame& frame) {
+  const std::size_t n = std::min({band.x.size(), band.lower.size(), band.upper.size()});
+  std::string svg, upper, lower;
+  std::size_t run = 0;
+  for (std::size_t i = 0; i <= n; ++i) {
+    const std::string top = i < n ? frame.point(band.x[i], band.upper[i]) : "";
+    const std::string bottom = i < n ? frame.point(band.x[i], band.lower[i]) : "";
+    if (!top.empty() && !bottom.empty()) {
+      upper += top;
+      lower.insert(0, bottom);
+      ++run;
+      continue;
+    }
+    if (run >= 2) {  // a gap or the end closes the run
+      svg += "<polygon points=\"" + upper + lower + "\" fill=\"" + escape(band.colour) +
+             "\" fill-opacity=\"0.22\" stroke=\"none\"/>\n";
+    }
+    upper.clear();
+    lower.clear();
+    run = 0;
+  }
+  return svg;
+}
+
+// Dots, or one polyline per run of finite points.
+inline std::string series(const Series& series, const Frame& frame) {
+  const std::size_t n = std::min(series.x.size(), series.y.size());
+  const std::string colour = escape(series.colour);
+  std::string svg, points;
+  for (std::size_t i = 0; i <= n; ++i) {
+    const std::string point = i < n ? frame.point(series.x[i], series.y[i]) : "";
+    if (series.points && !point.empty()) {
+      svg += format("<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.3\" fill=\"", frame.px(series.x[i]),
+                    frame.py(series.y[i])) +
+             colour + "\"/>\n";
+    } else if (!point.empty()) {
+      points += point;
+    } else if (!points.empty()) {  // a gap or the end closes the run
+      svg += "<polyline points=\"" + points + "\" fill=\"none\" stroke=\"" + colour +
+             "\" stroke-width=\"1.8\"" + (series.dashed ? " stroke-dasharray=\"6 4\"" : "") +
+             "/>\n";
+      points.clear();
+    }
+  }
+  return svg;
+}
+
+// Right of the plot, one row per series (its mark) and band (a swatch).
+inline std::string legend(const Panel& panel, const Frame& frame) {
+  const double x = frame.left + frame.width + 14;
+  double y = frame.top + 12;
+  std::string svg;
+  const auto label = [&](const std::string& text) {
+    svg += format("<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\">", x + 26, y) + escape(text) +
+           "</text>\n";
+    y += 18;
+  };
+  for (const Series& s : panel.series) {
+    svg += s.points ? format("<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"", x + 10, y - 4)
+                    : format(
+                          "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" "
+                          "stroke-width=\"1.8\"%s stroke=\"",
+                          x, y - 4, x + 20, y - 4, s.dashed ? " stroke-dasharray=\"6 4\"" : "");
+    svg += escape(s.colour) + "\"/>\n";
+    label(s.label);
+  }
+  for (const Band& b : panel.bands) {
+    svg += format(
+               "<rect x=\"%.2f\" y=\"%.2f\" width=\"20\" height=\"10\" fill-opacity=\"0.22\" "
+               "fill=\"",
+               x, y - 9) +
+           escape(b.colour) + "\"/>\n";
+    label(b.label);
+  }
+  return svg;
 }
 
 }  // namespace detail
@@ -187,15 +307,13 @@ inline std::string point(double px, double py) {
 inline std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (!std::isfinite(lo) || !std::isfinite(hi)) return {};
   if (lo > hi) std::swap(lo, hi);
-  const double magnitude = std::max(std::abs(lo), std::abs(hi));
-  if (hi - lo <= 1e-12 * magnitude) {
+  if (hi - lo <= 1e-12 * std::max(std::abs(lo), std::abs(hi))) {
     const double half = lo != 0 ? 0.1 * std::abs(lo) : 1.0;
     hi = lo + half;
     lo -= half;
   }
-  const double width = hi - lo;
   target = std::clamp(target, 3, 20);
-  const double raw = width / target;
+  const double raw = (hi - lo) / target;
   if (!std::isfinite(raw) || raw < 1e-300 || raw > 1e300) return {};
   // Candidates m * 10^e around raw; keep the one whose outer ticks span the
   // least (the tightest axis) among those giving 3 .. target + 2 ticks.
@@ -205,10 +323,9 @@ inline std::vector<double> nice_ticks(double lo, double hi, int target) {
   for (int e = raw_exponent - 1; e <= raw_exponent + 1; ++e) {
     for (int m : {1, 2, 5}) {
       const double candidate = m * std::pow(10.0, e);
-      const double span = candidate * (std::ceil(hi / candidate) - std::floor(lo / candidate));
-      const double count = span / candidate + 1;
-      if (count >= 3 && count <= target + 2 && span < best_span) {
-        best_span = span;
+      const double intervals = std::ceil(hi / candidate) - std::floor(lo / candidate);
+      if (intervals >= 2 && intervals <= target + 1 && intervals * candidate < best_span) {
+        best_span = intervals * candidate;
         mantissa = m;
         exponent = e;
       }
@@ -222,9 +339,8 @@ inline std::vector<double> nice_ticks(double lo, double hi, int target) {
   const long long last = static_cast<long long>(std::ceil(hi / step)) + 1;
   std::vector<double> ticks;
   for (long long k = first; k <= last; ++k) {
-    const double tick = detail::parse_decimal(k * mantissa, exponent);
-    if (!std::isfinite(tick)) return {};
-    ticks.push_back(tick);
+    ticks.push_back(detail::parse_decimal(k * mantissa, exponent));
+    if (!std::isfinite(ticks.back())) return {};
   }
   while (ticks.size() > 2 && ticks[1] <= lo)
     ticks.erase(ticks.begin());
@@ -234,165 +350,41 @@ inline std::vector<double> nice_ticks(double lo, double hi, int target) {
 }
 
 inline std::string render_svg(const Figure& figure) {
-  using detail::escape;
   const double left = 80, legend_width = 160, header = figure.subtitle.empty() ? 40 : 62;
   const double plot_width = std::max(figure.width - left - legend_width, 100.0);
   const double plot_height = std::max(figure.panel_height - 80, 40.0);
   const double height = header + figure.panels.size() * figure.panel_height + 8;
-  char buffer[512];
-  std::snprintf(buffer, sizeof buffer,
-                "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg "
-                "xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
-                "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n"
-                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
-                figure.width, height, figure.width, height);
-  std::string svg = buffer;
-  svg += "<text x=\"16\" y=\"26\" font-size=\"17\" font-weight=\"bold\">" + escape(figure.title) +
-         "</text>\n";
+  std::string svg = detail::format(
+                        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg "
+                        "xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+                        "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n",
+                        figure.width, height, figure.width, height) +
+                    "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n" +
+                    "<text x=\"16\" y=\"26\" font-size=\"17\" font-weight=\"bold\">" +
+                    detail::escape(figure.title) + "</text>\n";
   if (!figure.subtitle.empty()) {
-    svg += "<text x=\"16\" y=\"48\" fill=\"#444\">" + escape(figure.subtitle) + "</text>\n";
+    svg += "<text x=\"16\" y=\"48\" fill=\"#444\">" + detail::escape(figure.subtitle) + "</text>\n";
   }
   for (std::size_t p = 0; p < figure.panels.size(); ++p) {
     const Panel& panel = figure.panels[p];
-    const double panel_top = header + p * figure.panel_height;
-    const double top = panel_top + 30, bottom = top + plot_height, right = left + plot_width;
-    detail::Extent x_extent, y_extent;
-    for (const Band& band : panel.bands) {
-      for (double v : band.x)
-        x_extent.add(v);
-      for (double v : band.lower)
-        y_extent.add(v);
-      for (double v : band.upper)
-        y_extent.add(v);
+    detail::Extent x, y;
+    for (const Band& b : panel.bands) {
+      x.add(b.x);
+      y.add(b.lower);
+      y.add(b.upper);
     }
-    for (const Series& series : panel.series) {
-      for (double v : series.x)
-        x_extent.add(v);
-      for (double v : series.y)
-        y_extent.add(v);
+    for (const Series& s : panel.series) {
+      x.add(s.x);
+      y.add(s.y);
     }
-    const std::vector<double> x_ticks = x_extent.ticks(6), y_ticks = y_extent.ticks(5);
-    const detail::Mapping map{x_ticks.front(), x_ticks.back(), y_ticks.front(),
-                              y_ticks.back(),  left,           top,
-                              plot_width,      plot_height};
-    svg += "<text x=\"" + std::to_string(int(left)) + "\" y=\"" + std::to_string(int(top - 10)) +
-           "\" font-size=\"14\" font-weight=\"bold\">" + escape(panel.title) + "</text>\n";
-    // Grid and tick labels: the axis spans exactly the outer ticks.
-    const std::vector<std::string> x_labels = detail::format_ticks(x_ticks);
-    const std::vector<std::string> y_labels = detail::format_ticks(y_ticks);
-    for (std::size_t k = 0; k < x_ticks.size(); ++k) {
-      double px = 0, py = 0;
-      map.pixel(x_ticks[k], y_ticks.front(), px, py);
-      std::snprintf(buffer, sizeof buffer,
-                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e4e4e4\"/>\n"
-                    "<text class=\"tick x\" x=\"%.2f\" y=\"%.2f\" font-size=\"12\" "
-                    "text-anchor=\"middle\">%s</text>\n",
-                    px, top, px, bottom, px, bottom + 16, x_labels[k].c_str());
-      svg += buffer;
-    }
-    for (std::size_t k = 0; k < y_ticks.size(); ++k) {
-      double px = 0, py = 0;
-      map.pixel(x_ticks.front(), y_ticks[k], px, py);
-      std::snprintf(buffer, sizeof buffer,
-                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"#e4e4e4\"/>\n"
-                    "<text class=\"tick y\" x=\"%.2f\" y=\"%.2f\" font-size=\"12\" "
-                    "text-anchor=\"end\">%s</text>\n",
-                    left, py, right, py, left - 6, py + 4, y_labels[k].c_str());
-      svg += buffer;
-    }
-    std::snprintf(buffer, sizeof buffer,
-                  "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"none\" "
-                  "stroke=\"#888\"/>\n<text x=\"%.2f\" y=\"%.2f\" text-anchor=\"middle\">",
-                  left, top, plot_width, plot_height, left + plot_width / 2, bottom + 36);
-    svg += buffer + escape(detail::axis_label(panel.x_label, panel.x_unit)) + "</text>\n";
-    std::snprintf(buffer, sizeof buffer,
-                  "<text x=\"20\" y=\"%.2f\" transform=\"rotate(-90 20 %.2f)\" "
-                  "text-anchor=\"middle\">",
-                  top + plot_height / 2, top + plot_height / 2);
-    svg += buffer + escape(detail::axis_label(panel.y_label, panel.y_unit)) + "</text>\n";
-
-    // Bands under the series; each finite run of points is one polygon.
-    for (const Band& band : panel.bands) {
-      const std::size_t n = std::min({band.x.size(), band.lower.size(), band.upper.size()});
-      std::size_t i = 0;
-      while (i < n) {
-        std::vector<std::pair<double, double>> upper, lower;
-        for (; i < n; ++i) {
-          double px = 0, upper_y = 0, lower_y = 0;
-          if (!map.pixel(band.x[i], band.upper[i], px, upper_y) ||
-              !map.pixel(band.x[i], band.lower[i], px, lower_y)) {
-            ++i;
-            break;
-          }
-          upper.emplace_back(px, upper_y);
-          lower.emplace_back(px, lower_y);
-        }
-        if (upper.size() < 2) continue;
-        std::string points;
-        for (const auto& [px, py] : upper)
-          points += detail::point(px, py);
-        for (auto it = lower.rbegin(); it != lower.rend(); ++it) {
-          points += detail::point(it->first, it->second);
-        }
-        svg += "<polygon points=\"" + points + "\" fill=\"" + escape(band.colour) +
-               "\" fill-opacity=\"0.22\" stroke=\"none\"/>\n";
-      }
-    }
-    for (const Series& series : panel.series) {
-      const std::size_t n = std::min(series.x.size(), series.y.size());
-      const std::string colour = escape(series.colour);
-      std::string points;
-      for (std::size_t i = 0; i <= n; ++i) {
-        double px = 0, py = 0;
-        const bool finite = i < n && map.pixel(series.x[i], series.y[i], px, py);
-        if (finite && series.points) {
-          std::snprintf(buffer, sizeof buffer, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.3\" fill=\"",
-                        px, py);
-          svg += buffer + colour + "\"/>\n";
-        } else if (finite) {
-          points += detail::point(px, py);
-        } else if (!points.empty()) {  // a gap or the end: close this run
-          svg += "<polyline points=\"" + points + "\" fill=\"none\" stroke=\"" + colour +
-                 "\" stroke-width=\"1.8\"" + (series.dashed ? " stroke-dasharray=\"6 4\"" : "") +
-                 "/>\n";
-          points.clear();
-        }
-      }
-    }
-
-    // Legend, right of the plot: one row per series and band.
-    double row = top + 12;
-    const double swatch = right + 14, text_x = right + 40;
-    for (const Series& series : panel.series) {
-      const std::string colour = escape(series.colour);
-      if (series.points) {
-        std::snprintf(buffer, sizeof buffer, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"",
-                      swatch + 10, row - 4);
-      } else {
-        std::snprintf(
-            buffer, sizeof buffer,
-            "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke-width=\"1.8\"%s "
-            "stroke=\"",
-            swatch, row - 4, swatch + 20, row - 4,
-            series.dashed ? " stroke-dasharray=\"6 4\"" : "");
-      }
-      svg += buffer + colour + "\"/>\n";
-      std::snprintf(buffer, sizeof buffer, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\">", text_x,
-                    row);
-      svg += buffer + escape(series.label) + "</text>\n";
-      row += 18;
-    }
-    for (const Band& band : panel.bands) {
-      std::snprintf(buffer, sizeof buffer,
-                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"20\" height=\"10\" fill-opacity=\"0.22\" "
-                    "fill=\"",
-                    swatch, row - 9);
-      svg += buffer + escape(band.colour) + "\"/>\n";
-      std::snprintf(buffer, sizeof buffer, "<text x=\"%.2f\" y=\"%.2f\" font-size=\"12\">", text_x,
-                    row);
-      svg += buffer + escape(band.label) + "</text>\n";
-      row += 18;
-    }
+    const double top = header + p * figure.panel_height + 30;
+    const detail::Frame frame{x.ticks(6), y.ticks(5), left, top, plot_width, plot_height};
+    svg += detail::axes(panel, frame);
+    for (const Band& b : panel.bands)
+      svg += detail::band(b, frame);  // under the series
+    for (const Series& s : panel.series)
+      svg += detail::series(s, frame);
+    svg += detail::legend(panel, frame);
   }
   return svg + "</svg>\n";
 }
