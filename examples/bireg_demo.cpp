@@ -35,8 +35,8 @@ namespace {
 constexpr double kDegrees = 180.0 / 3.14159265358979323846;
 constexpr double kLevel = 0.95;  // of the confidence bands
 constexpr const char* kSubtitle =
-    "dots: data in the log chart at the fitted start g0, where the fitted geodesic is a straight "
-    "line; shaded: its 95% band";
+    "dots: data in the log chart at the fitted start g0, where the fit is a straight line; "
+    "shaded: its 95% band";
 
 template <class G>
 struct Fitted {

@@ -36,7 +36,7 @@ namespace bireg_plot {
 // 1e-12 of its magnitude, below what doubles resolve for ticks) is widened to
 // lo +- 10% (+- 1 about zero); a non-finite bound, a width that
 // overflows, or magnitudes beyond 1e+-300 give an empty vector.
-std::vector<double> nice_ticks(double lo, double hi, int target = 5);
+inline std::vector<double> nice_ticks(double lo, double hi, int target = 5);
 
 struct Series {
   std::string label;
@@ -69,7 +69,7 @@ struct Figure {
 
 // Well-formed XML: text is escaped, non-finite points are skipped (a line or
 // band is split there), empty series draw nothing but keep their legend entry.
-std::string render_svg(const Figure& figure);
+inline std::string render_svg(const Figure& figure);
 
 // ---- implementation ---------------------------------------------------------
 
