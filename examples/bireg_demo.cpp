@@ -110,8 +110,9 @@ ChartBand<G> chart_band(const bireg::FitCovariance<G>& covariance, double quanti
 // the whole motion becomes readable.
 enum class View { chart, about_fit };
 
-// Three chart coordinates, first .. first + 2, against time: the data
-// log(g0^{-1} f_i), the fitted line s X and its band, times `scale`.
+// Three chart coordinates, first .. first + 2, against time, times `scale`:
+// the data log(g0^{-1} f_i), the fitted line s X and its band (View::chart),
+// or the data minus s X with the band about zero (View::about_fit).
 template <class G>
 bireg_plot::Panel chart_panel(const Fitted<G>& fitted, const ChartBand<G>& band, int first,
                               double scale, View view, bireg_plot::Panel panel) {

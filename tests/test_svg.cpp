@@ -36,11 +36,12 @@ double decimal(long long digits, int exponent) {
 
 // Why `ticks` are not k * m * 10^e for consecutive integers k, m in {1, 2, 5},
 // each exactly the double nearest to that decimal; nullopt if they are.
-// The step's mantissa is read from the spacing of the outer ticks, whose
-// rounding is at most |tick| * 2^-52 per tick, i.e. relative to the step at
-// most (|tick| / step) * 2^-51 <= 1e7 * 4.4e-16 for the ranges tested here:
-// far below the 1e-4 used, and 1, 2 and 5 are a factor 2 apart, so the
-// mantissa cannot be mistaken. The ticks themselves are then compared
+// The step's mantissa is read from the mean spacing of the outer ticks,
+// whose rounding is at most |tick| * 2^-53 each, so relative to the step at
+// most (|tick| / step) * 2^-52: largest for the 1e-9 wide range at 1 (step
+// 1e-10, |tick| / step = 1e10), 1e10 * 2.2e-16 = 2.2e-6, below the 1e-4
+// used; and 1, 2 and 5 are a factor 2 apart, so the mantissa cannot be
+// mistaken. The ticks themselves are then compared
 // exactly: the claim is that they are the decimals, not close to them.
 std::optional<std::string> not_round(const std::vector<double>& ticks) {
   if (ticks.size() < 2) return "fewer than 2 ticks";
