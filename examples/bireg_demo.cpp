@@ -5,14 +5,16 @@
 //
 // For each trajectory it prints the fitted velocities, the residual RMS
 // before (about the data's bi-invariant mean) and after the fit, the
-// iterations and the time taken, and writes an SVG: the data in the log chart
-// at the fitted start point, log(g0^{-1} f_i) against time, where the fitted
-// geodesic is the straight line s X.
+// iterations, the time taken and the 95% confidence band's width, and writes
+// an SVG (examples/svg_plot.hpp): the data in the log chart at the fitted
+// start point, log(g0^{-1} f_i) against time, where the fitted geodesic is
+// the straight line s X, with its confidence band shaded around it.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,9 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/confidence.hpp"
+#include "bireg/statistics/covariance.hpp"
+#include "svg_plot.hpp"
 
 #ifndef BIREG_DEMO_DATA_DIR
 #define BIREG_DEMO_DATA_DIR "examples/data"
@@ -28,87 +33,10 @@
 namespace {
 
 constexpr double kDegrees = 180.0 / 3.14159265358979323846;
-
-// One panel of the picture: several coordinates against time, as dots (data)
-// and straight segments (the fitted geodesic in the chart).
-struct Panel {
-  std::string title;
-  std::string unit;
-  std::vector<std::string> labels;
-  std::vector<std::vector<double>> data;   // [coordinate][observation]
-  std::vector<double> fit_start, fit_end;  // fitted line at t_min and t_max
-};
-
-std::string svg_panels(const std::string& title, const std::vector<double>& t,
-                       const std::vector<Panel>& panels) {
-  const char* colours[] = {"#d62728", "#2ca02c", "#1f77b4"};
-  const double width = 720, panel_height = 260, left = 70, right = 60, top = 56;
-  const double plot_w = width - left - right, plot_h = panel_height - 70;
-  const double height = top + panels.size() * panel_height;
-  const auto [t_lo, t_hi] = std::minmax_element(t.begin(), t.end());
-  const double t0 = *t_lo, t1 = *t_hi;
-  std::string svg;
-  char buf[512];
-  std::snprintf(
-      buf, sizeof buf,
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
-      "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" "
-      "fill=\"white\"/>\n<text x=\"%.0f\" y=\"22\" font-size=\"15\">%s</text>\n"
-      "<text x=\"%.0f\" y=\"40\" fill=\"#555\">dots: data, lines: the fitted geodesic "
-      "(a straight line in this chart)</text>\n",
-      width, height, left, title.c_str(), left);
-  svg += buf;
-  for (std::size_t p = 0; p < panels.size(); ++p) {
-    const Panel& panel = panels[p];
-    const double y_top = top + p * panel_height + 20;
-    double lo = 0, hi = 0;
-    for (const auto& series : panel.data) {
-      for (double y : series)
-        lo = std::min(lo, y), hi = std::max(hi, y);
-    }
-    const double pad = 0.05 * (hi - lo + 1e-12);
-    lo -= pad;
-    hi += pad;
-    const auto x_of = [&](double ti) { return left + (ti - t0) / (t1 - t0) * plot_w; };
-    const auto y_of = [&](double y) { return y_top + (hi - y) / (hi - lo) * plot_h; };
-    std::snprintf(buf, sizeof buf,
-                  "<text x=\"%.0f\" y=\"%.0f\" font-size=\"13\">%s</text>\n"
-                  "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
-                  "stroke=\"#999\"/>\n",
-                  left, y_top - 6, panel.title.c_str(), left, y_top, plot_w, plot_h);
-    svg += buf;
-    for (int tick = 0; tick <= 4; ++tick) {  // axis labels
-      const double y = lo + (hi - lo) * tick / 4, ti = t0 + (t1 - t0) * tick / 4;
-      std::snprintf(buf, sizeof buf,
-                    "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"end\">%.3g</text>\n"
-                    "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">%.4g</text>\n",
-                    left - 6, y_of(y) + 4, y, x_of(ti), y_top + plot_h + 16, ti);
-      svg += buf;
-    }
-    std::snprintf(buf, sizeof buf,
-                  "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">time [s]</text>\n"
-                  "<text x=\"16\" y=\"%.0f\" transform=\"rotate(-90 16 %.0f)\" "
-                  "text-anchor=\"middle\">%s</text>\n",
-                  left + plot_w / 2, y_top + plot_h + 34, y_top + plot_h / 2, y_top + plot_h / 2,
-                  panel.unit.c_str());
-    svg += buf;
-    for (std::size_t k = 0; k < panel.data.size(); ++k) {
-      const char* colour = colours[k % 3];
-      for (std::size_t i = 0; i < t.size(); ++i) {
-        std::snprintf(buf, sizeof buf, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.2\" fill=\"%s\"/>\n",
-                      x_of(t[i]), y_of(panel.data[k][i]), colour);
-        svg += buf;
-      }
-      std::snprintf(buf, sizeof buf,
-                    "<line x1=\"%.2f\" y1=\"%.2f\" x2=\"%.2f\" y2=\"%.2f\" stroke=\"%s\" "
-                    "stroke-width=\"1.5\"/>\n<text x=\"%.0f\" y=\"%.0f\" fill=\"%s\">%s</text>\n",
-                    x_of(t0), y_of(panel.fit_start[k]), x_of(t1), y_of(panel.fit_end[k]), colour,
-                    left + plot_w + 10, y_top + 16 + 18.0 * k, colour, panel.labels[k].c_str());
-      svg += buf;
-    }
-  }
-  return svg + "</svg>\n";
-}
+constexpr double kLevel = 0.95;  // of the confidence bands
+constexpr const char* kSubtitle =
+    "dots: data in the log chart at the fitted start g0, where the fit is a straight line; "
+    "shaded: its 95% band";
 
 template <class G>
 struct Fitted {
@@ -145,19 +73,119 @@ bool fit_file(const std::string& path, bireg::io::Format format, Fitted<G>& out)
   return true;
 }
 
-// Coordinates of log(g0^{-1} f_i), and of the fitted line, for the picture.
+// The 95% confidence band of the fitted geodesic, in the chart the pictures
+// use. The fitted pose at s is gamma(s) exp(eps), eps with covariance
+// pose_covariance(); in the chart at g0 that is log(exp(sX) exp(eps)) = sX +
+// J_r(sX)^{-1} eps to first order, so the chart covariance is J_r(sX)^{-1}
+// C J_r(sX)^{-T}. The half-widths are the projections of the pose's 95%
+// ellipsoid (pose_quantile), so each time's band holds all coordinates at
+// once, as in README "How sure is the fit".
 template <class G>
-std::vector<Panel> chart_panels(const Fitted<G>& fitted, int first, int count, Panel panel) {
-  const auto& geodesic = *fitted.result.geodesic;
-  for (int k = first; k < first + count; ++k) {
-    std::vector<double> series;
-    for (const auto& f : fitted.data.observations)
-      series.push_back(bireg::log_at<G>(geodesic.start(), f)[k]);
-    panel.data.push_back(series);
-    panel.fit_start.push_back(0.0);
-    panel.fit_end.push_back(geodesic.displacement()[k]);
+struct ChartBand {
+  std::vector<double> times;
+  std::vector<typename G::Tangent> centre, half_width;
+};
+
+template <class G>
+ChartBand<G> chart_band(const bireg::FitCovariance<G>& covariance, double quantile) {
+  constexpr int kGrid = 61;  // enough for a smooth outline at 760 px
+  const auto& geodesic = covariance.geodesic;
+  const typename G::Tangent x = geodesic.displacement();
+  ChartBand<G> band;
+  for (int j = 0; j < kGrid; ++j) {
+    const double s = static_cast<double>(j) / (kGrid - 1);
+    const double t = geodesic.t_min() + s * (geodesic.t_max() - geodesic.t_min());
+    const typename G::AdMatrix to_chart = bireg::right_jacobian_inverse<G>(s * x);
+    const typename G::AdMatrix chart_covariance =
+        to_chart * bireg::pose_covariance(covariance, t) * to_chart.transpose();
+    band.times.push_back(t);
+    band.centre.push_back(s * x);
+    band.half_width.push_back(bireg::half_widths(chart_covariance, quantile));
   }
-  return {panel};
+  return band;
+}
+
+// Which picture of three chart coordinates: the data and the fitted line,
+// or the data minus the fitted line, where a band too narrow to see beside
+// the whole motion becomes readable.
+enum class View { chart, about_fit };
+
+// Three chart coordinates, first .. first + 2, against time, times `scale`:
+// the data log(g0^{-1} f_i), the fitted line s X and its band (View::chart),
+// or the data minus s X with the band about zero (View::about_fit).
+template <class G>
+bireg_plot::Panel chart_panel(const Fitted<G>& fitted, const ChartBand<G>& band, int first,
+                              double scale, View view, bireg_plot::Panel panel) {
+  const char* colours[] = {"#d62728", "#2ca02c", "#1f77b4"};
+  const char* names[] = {"x", "y", "z"};
+  const auto& geodesic = *fitted.result.geodesic;
+  const bool about_fit = view == View::about_fit;
+  for (int c = 0; c < 3; ++c) {
+    const int k = first + c;
+    const std::string name = names[c];
+    bireg_plot::Series data{name + " data", colours[c], fitted.data.covariates, {}, true, false};
+    for (std::size_t i = 0; i < fitted.data.observations.size(); ++i) {
+      const double line =
+          about_fit ? geodesic.normalized(fitted.data.covariates[i]) * geodesic.displacement()[k]
+                    : 0.0;
+      data.y.push_back(scale *
+                       (bireg::log_at<G>(geodesic.start(), fitted.data.observations[i])[k] - line));
+    }
+    bireg_plot::Series fit{name + " fit", colours[c], band.times, {}, false, false};
+    bireg_plot::Band confidence{
+        name + (about_fit ? " 95% band" : " fit, 95% band"), colours[c], band.times, {}, {}};
+    for (std::size_t j = 0; j < band.times.size(); ++j) {
+      const double centre = about_fit ? 0.0 : scale * band.centre[j][k];
+      const double half = scale * band.half_width[j][k];
+      fit.y.push_back(centre);
+      confidence.lower.push_back(centre - half);
+      confidence.upper.push_back(centre + half);
+    }
+    panel.series.push_back(data);
+    if (!about_fit) panel.series.push_back(fit);
+    panel.bands.push_back(confidence);
+  }
+  if (about_fit) {
+    panel.series.push_back(
+        {"fitted line", "#333", {geodesic.t_min(), geodesic.t_max()}, {0, 0}, false, true});
+  }
+  return panel;
+}
+
+// The largest half-width of coordinates first .. first + 2 along the band.
+template <class G>
+double widest(const ChartBand<G>& band, int first) {
+  double widest = 0;
+  for (const auto& half : band.half_width) {
+    widest = std::max(widest, half.template segment<3>(first).maxCoeff());
+  }
+  return widest;
+}
+
+// Standard error of a speed |v| by the delta method: sqrt(u^T C u), u = v / |v|.
+template <class Vector, class Matrix>
+double speed_standard_error(const Vector& v, const Matrix& c) {
+  const Vector u = v.normalized();
+  return std::sqrt(std::max(0.0, u.dot(c * u)));
+}
+
+// The robust covariance of the fit (real data: the noise need not be the
+// same all along) and its 95% pose quantile; false, with a message, where
+// the covariance is undefined.
+template <class G>
+bool fit_covariance(const Fitted<G>& fitted, bireg::FitCovariance<G>& covariance,
+                    double& quantile) {
+  covariance = bireg::covariance(fitted.result, fitted.data.covariates, {},
+                                 bireg::CovarianceFlavour::robust);
+  const std::optional<double> q =
+      covariance.defined() ? bireg::pose_quantile(covariance, kLevel) : std::optional<double>();
+  if (!q) {
+    std::fprintf(stderr, "bireg_demo: no confidence band: %s\n",
+                 covariance.defined() ? "too few degrees of freedom" : covariance.message.c_str());
+    return false;
+  }
+  quantile = *q;
+  return true;
 }
 
 void write_file(const std::string& path, const std::string& text) {
@@ -197,10 +225,25 @@ int main(int argc, char** argv) {
                 r.diagnostics.residual_rms_about_mean * kDegrees,
                 r.diagnostics.residual_rms * kDegrees);
     print_common(imu);
-    Panel panel{"rotation vector log(g0^-1 f)", "rad", {"x", "y", "z"}, {}, {}, {}};
-    write_file(out_dir + "/demo_so3_imu.svg",
-               svg_panels("x-IMU orientation: data in the log chart at the fitted start",
-                          imu.data.covariates, chart_panels(imu, 0, 3, panel)));
+    bireg::FitCovariance<Rotation> covariance;
+    double quantile = 0;
+    if (!fit_covariance(imu, covariance, quantile)) return 1;
+    const ChartBand<Rotation> band = chart_band(covariance, quantile);
+    const double speed_error =
+        speed_standard_error(w, bireg::velocity_covariance(covariance)) * kDegrees;
+    std::printf(
+        "  95%% confidence band        +-%.2f deg at most; speed standard error %.2f deg/s\n",
+        widest(band, 0) * kDegrees, speed_error);
+    bireg_plot::Figure figure;
+    figure.title = "x-IMU orientation: geodesic fit with its 95% confidence band";
+    figure.subtitle = kSubtitle;
+    figure.panels.push_back(chart_panel(
+        imu, band, 0, kDegrees, View::chart,
+        {"rotation: log(g0^-1 f), body axes", "time", "s", "rotation vector", "deg", {}, {}}));
+    figure.panels.push_back(
+        chart_panel(imu, band, 0, kDegrees, View::about_fit,
+                    {"rotation minus the fitted line", "time", "s", "deviation", "deg", {}, {}}));
+    write_file(out_dir + "/demo_so3_imu.svg", bireg_plot::render_svg(figure));
   }
 
   // DeepMimic walk: a rigid motion, SE(3) (tangent = translation, rotation).
@@ -228,14 +271,38 @@ int main(int argc, char** argv) {
     std::printf("                             after: %.4f m translation, %.2f deg rotation\n",
                 std::sqrt(translation_sq / n), std::sqrt(rotation_sq / n) * kDegrees);
     print_common(walk);
-    std::vector<Panel> panels =
-        chart_panels(walk, 0, 3, Panel{"translation part", "m", {"x", "y", "z"}, {}, {}, {}});
-    const std::vector<Panel> rotation =
-        chart_panels(walk, 3, 3, Panel{"rotation part", "rad", {"rx", "ry", "rz"}, {}, {}, {}});
-    panels.push_back(rotation.front());
-    write_file(out_dir + "/demo_se3_walk.svg",
-               svg_panels("DeepMimic walk: data in the log chart at the fitted start",
-                          walk.data.covariates, panels));
+    bireg::FitCovariance<Pose> covariance;
+    double quantile = 0;
+    if (!fit_covariance(walk, covariance, quantile)) return 1;
+    const ChartBand<Pose> band = chart_band(covariance, quantile);
+    const Pose::AdMatrix velocity_covariance = bireg::velocity_covariance(covariance);
+    const double linear_error = speed_standard_error(
+        Eigen::Vector3d(v.head<3>()), Eigen::Matrix3d(velocity_covariance.topLeftCorner<3, 3>()));
+    const double angular_error =
+        speed_standard_error(Eigen::Vector3d(v.tail<3>()),
+                             Eigen::Matrix3d(velocity_covariance.bottomRightCorner<3, 3>())) *
+        kDegrees;
+    std::printf(
+        "  95%% confidence band        +-%.4f m, +-%.2f deg at most; speed s.e. %.3f "
+        "m/s, %.2f deg/s\n",
+        widest(band, 0), widest(band, 3) * kDegrees, linear_error, angular_error);
+    bireg_plot::Figure figure;
+    figure.title = "DeepMimic walk, pelvis: geodesic fit with its 95% confidence band";
+    figure.subtitle = kSubtitle;
+    figure.panel_height = 250;
+    figure.panels.push_back(
+        chart_panel(walk, band, 0, 1.0, View::chart,
+                    {"translation part of log(g0^-1 f)", "time", "s", "translation", "m", {}, {}}));
+    figure.panels.push_back(
+        chart_panel(walk, band, 0, 1.0, View::about_fit,
+                    {"translation minus the fitted line", "time", "s", "deviation", "m", {}, {}}));
+    figure.panels.push_back(chart_panel(
+        walk, band, 3, kDegrees, View::chart,
+        {"rotation part of log(g0^-1 f)", "time", "s", "rotation vector", "deg", {}, {}}));
+    figure.panels.push_back(
+        chart_panel(walk, band, 3, kDegrees, View::about_fit,
+                    {"rotation minus the fitted line", "time", "s", "deviation", "deg", {}, {}}));
+    write_file(out_dir + "/demo_se3_walk.svg", bireg_plot::render_svg(figure));
   }
   return 0;
 }
