@@ -73,7 +73,8 @@ TEMPLATE_TEST_CASE("every group satisfies the group laws", "[groups]", BIREG_ALL
   const long double finite_difference =
       100 * std::pow(static_cast<long double>(eps<Scalar>()), 2.0L / 3);
   CAPTURE(G::name, e.log_of_exp, e.exp_of_log, e.inverse, e.associativity, e.ad_antisymmetry,
-          e.ad_exp, e.ad_homomorphism, e.ad_conjugation, e.jacobian, e.jacobian_inverse, e.psi);
+          e.ad_exp, e.ad_homomorphism, e.ad_conjugation, e.jacobian, e.jacobian_inverse,
+          e.jacobian_pair, e.psi);
   REQUIRE(e.log_of_exp <= algebraic);
   REQUIRE(e.exp_of_log <= algebraic);
   REQUIRE(e.inverse <= algebraic);
@@ -84,12 +85,14 @@ TEMPLATE_TEST_CASE("every group satisfies the group laws", "[groups]", BIREG_ALL
   REQUIRE(e.ad_conjugation <= algebraic);
   REQUIRE(e.jacobian <= finite_difference);
   REQUIRE(e.jacobian_inverse <= algebraic);
+  REQUIRE(e.jacobian_pair <= algebraic);
   REQUIRE(e.psi <= algebraic);
 }
 
 // The laws can fail: a group whose right Jacobian has the wrong sign of its
 // first-order term (the left Jacobian instead) is caught by the finite
-// differences and by the psi identity, by orders of magnitude.
+// differences, by the psi identity and by its (inherited, correct)
+// right_jacobian_pair disagreeing with it, by orders of magnitude.
 struct SO3WithLeftJacobian : bireg::SO3<double> {
   static AdMatrix right_jacobian(const Tangent& x) {
     return bireg::SO3<double>::right_jacobian(-x);
@@ -100,6 +103,7 @@ TEST_CASE("the group laws catch a wrong Jacobian", "[groups]") {
   const auto e = bireg::testing::group_law_errors<SO3WithLeftJacobian>(rng, 20, kSampleScale);
   REQUIRE(e.jacobian > 1e-2);
   REQUIRE(e.jacobian_inverse > 1e-2);
+  REQUIRE(e.jacobian_pair > 1e-2);
   REQUIRE(e.psi > 1e-2);
 }
 

@@ -58,7 +58,8 @@ TEMPLATE_TEST_CASE("matrix groups satisfy the group laws", "[matrix_group]",
   std::mt19937 rng(92);
   const auto e = bireg::testing::group_law_errors<G>(rng, 50, kScale);
   CAPTURE(e.log_of_exp, e.exp_of_log, e.inverse, e.associativity, e.ad_antisymmetry, e.ad_exp,
-          e.ad_homomorphism, e.ad_conjugation, e.jacobian, e.jacobian_inverse, e.psi);
+          e.ad_homomorphism, e.ad_conjugation, e.jacobian, e.jacobian_inverse, e.jacobian_pair,
+          e.psi);
   REQUIRE(e.log_of_exp <= kTolerance);
   REQUIRE(e.exp_of_log <= kTolerance);
   REQUIRE(e.inverse <= kTolerance);
@@ -69,6 +70,7 @@ TEMPLATE_TEST_CASE("matrix groups satisfy the group laws", "[matrix_group]",
   REQUIRE(e.ad_conjugation <= kTolerance);
   REQUIRE(e.jacobian <= 100 * std::pow(2.220446049250313e-16, 2.0 / 3));
   REQUIRE(e.jacobian_inverse <= kTolerance);
+  REQUIRE(e.jacobian_pair <= kTolerance);
   REQUIRE(e.psi <= kTolerance);
 }
 

@@ -11,6 +11,10 @@
 //       fallback: the power series in ad_x (J_r is entire; J_r^{-1} =
 //       sum_k b_k (-ad_x)^k, b_k = B_k/k!, converges for spectral radius
 //       below 2 pi), truncated where the terms fall below epsilon.
+//   RightJacobianPair<AdMatrix> right_jacobian_pair(const Tangent& x)
+//       J_r(x) and J_r(x)^{-1} together, sharing their common factors (the
+//       covariance needs both at every observation).
+//       fallback: right_jacobian(x) and right_jacobian_inverse(x).
 //   struct ClosedFormPsi                             psi_s(ad_x) r in closed form
 //       (see math/psi_closed_form.hpp and SO3::ClosedFormPsi for the
 //       interface) fallback: the power series of math/psi_series.hpp.
@@ -52,8 +56,17 @@ template <class G>
 using right_jacobian_inverse =
     decltype(G::right_jacobian_inverse(std::declval<const Tangent<G>&>()));
 template <class G>
+using right_jacobian_pair = decltype(G::right_jacobian_pair(std::declval<const Tangent<G>&>()));
+template <class G>
 using closed_form_psi = typename G::ClosedFormPsi;
 }  // namespace capability_detail
+
+// J_r(x) and its inverse at one x.
+template <class AdMatrix>
+struct RightJacobianPair {
+  AdMatrix jacobian;  // J_r(x)
+  AdMatrix inverse;   // J_r(x)^{-1}
+};
 
 // provides_v<G, capability_detail::X>: whether G declares capability X.
 template <class G, template <class> class Capability>
@@ -126,6 +139,16 @@ typename G::AdMatrix right_jacobian_inverse(const typename G::Tangent& x) {
     return capability_detail::series_in_minus_ad(
         G::ad(x), [](int k) { return kBernoulliOverFactorial[static_cast<std::size_t>(k)]; },
         static_cast<int>(kBernoulliTableSize));
+  }
+}
+
+// J_r(x) and J_r(x)^{-1}, from the group's shared computation when it has one.
+template <class G>
+RightJacobianPair<typename G::AdMatrix> right_jacobian_pair(const typename G::Tangent& x) {
+  if constexpr (provides_v<G, capability_detail::right_jacobian_pair>) {
+    return G::right_jacobian_pair(x);
+  } else {
+    return {right_jacobian<G>(x), right_jacobian_inverse<G>(x)};
   }
 }
 

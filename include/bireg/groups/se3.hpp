@@ -126,6 +126,14 @@ struct SE3 {
     const Matrix3 j = Rotation::right_jacobian(xi.template tail<3>());
     return block_triangular(j, -j * coupling_of_jacobian_inverse(xi) * j);
   }
+  // Both at once: SO(3)'s pair and L are computed once.
+  static RightJacobianPair<AdMatrix> right_jacobian_pair(const Tangent& xi) {
+    const RightJacobianPair<Matrix3> rotation =
+        Rotation::right_jacobian_pair(xi.template tail<3>());
+    const Matrix3 coupling = coupling_of_jacobian_inverse(xi);
+    return {block_triangular(rotation.jacobian, -rotation.jacobian * coupling * rotation.jacobian),
+            block_triangular(rotation.inverse, coupling)};
+  }
 
   // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
   // to within tol (max-norm), all finite.
@@ -190,12 +198,18 @@ struct SE3 {
     using std::sqrt;
     const Vector3 rho = xi.template head<3>(), omega = xi.template tail<3>();
     const Scalar angle = sqrt(omega.squaredNorm());
-    const Matrix3 w = Rotation::hat(omega), p = Rotation::hat(rho);
+    const Scalar omega_dot_rho = omega.dot(rho);
     const Scalar e = small_angle::one_minus_half_x_cot_half_x_over_x2(angle);
     const Scalar e_derivative_over_angle =
         small_angle::one_minus_half_x_cot_half_x_over_x2_derivative_over_x(angle);
-    return p / Scalar(2) + e * (w * p + p * w) +
-           (omega.dot(rho) * e_derivative_over_angle) * (w * w);
+    // hat(a) hat(b) = b a^T - (a . b) I gives W P + P W and W^2 as outer
+    // products, without 3 x 3 matrix products.
+    const Matrix3 identity = Matrix3::Identity();
+    const Matrix3 w_p_plus_p_w =
+        rho * omega.transpose() + omega * rho.transpose() - 2 * omega_dot_rho * identity;
+    const Matrix3 w_squared = omega * omega.transpose() - (angle * angle) * identity;
+    return Rotation::hat(rho) / Scalar(2) + e * w_p_plus_p_w +
+           (omega_dot_rho * e_derivative_over_angle) * w_squared;
   }
 };
 

@@ -151,6 +151,17 @@ struct SO3 {
     return AdMatrix::Identity() + w / Scalar(2) +
            small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * (w * w);
   }
+  // Both at once: W, W^2 and the angle are shared.
+  static RightJacobianPair<AdMatrix> right_jacobian_pair(const Tangent& omega) {
+    using std::sqrt;
+    const Scalar angle = sqrt(omega.squaredNorm());
+    const Algebra w = hat(omega);
+    const Algebra w2 = w * w;
+    return {AdMatrix::Identity() - small_angle::one_minus_cos_over_x2(angle) * w +
+                small_angle::x_minus_sin_over_x3(angle) * w2,
+            AdMatrix::Identity() + w / Scalar(2) +
+                small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * w2};
+  }
 
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.
   static bool is_element(const Element& r, Scalar tol = default_element_tolerance<Scalar>()) {

@@ -22,12 +22,23 @@
 namespace bireg {
 namespace small_angle {
 
+// The coefficients, derived in long double, rounded once to the caller's
+// precision (at compile time: a Horner loop over long doubles would convert
+// each coefficient at run time, on x86 through the x87 unit).
+template <class Scalar, std::size_t Count>
+constexpr std::array<Scalar, Count> in_precision(const std::array<long double, Count>& exact) {
+  std::array<Scalar, Count> rounded{};
+  for (std::size_t k = 0; k < Count; ++k)
+    rounded[k] = static_cast<Scalar>(exact[k]);
+  return rounded;
+}
+
 // sum_k coefficients[k] * x^k by Horner's rule, in the caller's precision.
 template <class Scalar, std::size_t Count>
-Scalar horner(const std::array<long double, Count>& coefficients, Scalar x) {
-  Scalar sum = static_cast<Scalar>(coefficients[Count - 1]);
+Scalar horner(const std::array<Scalar, Count>& coefficients, Scalar x) {
+  Scalar sum = coefficients[Count - 1];
   for (std::size_t k = Count - 1; k-- > 0;)
-    sum = sum * x + static_cast<Scalar>(coefficients[k]);
+    sum = sum * x + coefficients[k];
   return sum;
 }
 
@@ -106,7 +117,7 @@ template <class Scalar>
 Scalar x_minus_sin_over_x3(Scalar x) {
   using std::abs;
   using std::sin;
-  static constexpr auto kSeries = detail::x_minus_sin_series<14>();
+  static constexpr auto kSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
   if (abs(x) < Scalar(2)) return horner(kSeries, x * x);
   return (x - sin(x)) / (x * x * x);
 }
@@ -131,7 +142,7 @@ Scalar half_x_cot_half_x(Scalar x) {
 template <class Scalar>
 Scalar one_minus_half_x_cot_half_x_over_x2(Scalar x) {
   using std::abs;
-  static constexpr auto kSeries = detail::one_minus_half_cot_series<20>();
+  static constexpr auto kSeries = in_precision<Scalar>(detail::one_minus_half_cot_series<20>());
   if (abs(x) < Scalar(2)) return horner(kSeries, x * x);
   return (Scalar(1) - half_x_cot_half_x(x)) / (x * x);
 }
@@ -147,7 +158,8 @@ Scalar one_minus_half_x_cot_half_x_over_x2_derivative_over_x(Scalar x) {
   using std::abs;
   using std::cos;
   using std::sin;
-  static constexpr auto kSeries = detail::one_minus_half_cot_derivative_series<32>();
+  static constexpr auto kSeries =
+      in_precision<Scalar>(detail::one_minus_half_cot_derivative_series<32>());
   if (abs(x) < Scalar(3)) return horner(kSeries, x * x);
   const Scalar x2 = x * x;
   const Scalar sin_half = sin(x / Scalar(2)), cos_half = cos(x / Scalar(2));

@@ -163,18 +163,16 @@ Matrix square_root(const Matrix& s) {
 }
 
 // nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = map
-// force_i, C = sum z z^T (on C's numerical range: p its rank).
-template <class Map, class Force>
-typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& forces) {
+// force_i, C = sum z z^T = map (sum force force^T) map^T (on C's numerical
+// range: p its rank). `meat` is sum force force^T, so C costs no pass.
+template <class Map, class Force, class Meat>
+typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& forces,
+                                   const Meat& meat) {
   using Scalar = typename Map::Scalar;
   constexpr int p = Map::RowsAtCompileTime;
   using Matrix = Eigen::Matrix<Scalar, p, p>;
   using Vector = Eigen::Matrix<Scalar, p, 1>;
-  Matrix c = Matrix::Zero();
-  for (const Force& f : forces) {
-    const Vector z = map * f;
-    c.noalias() += z * z.transpose();
-  }
+  const Matrix c = map * meat * map.transpose();
   const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
   const Vector values = solver.eigenvalues();
   const Scalar largest = values[p - 1];
@@ -189,7 +187,7 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
   const Map whitening = inverse_root.asDiagonal() * solver.eigenvectors().transpose() * map;
   Scalar sum = 0;
   for (const Force& f : forces) {
-    const Scalar kappa = (whitening * f).squaredNorm();
+    const Scalar kappa = whitening.lazyProduct(f).squaredNorm();
     sum += kappa * kappa;
   }
   return sum > 0 ? Scalar(rank * (rank + 2)) / sum : Scalar(0);
@@ -211,7 +209,6 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
   using AdMatrix = typename G::AdMatrix;
   using Result = FitCovariance<G>;
   using EndpointMatrix = typename Result::EndpointMatrix;
-  using Block = Eigen::Matrix<Scalar, 2 * G::dof, G::dof>;
   using Vector2 = Eigen::Matrix<Scalar, 2, 1>;
   using Matrix2 = Eigen::Matrix<Scalar, 2, 2>;
   constexpr int d = G::dof;
@@ -282,22 +279,28 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
   std::vector<ForceVector> forces;  // robust: w_i Psi_i r_i / sqrt(v_i), core part
   if (flavour == CovarianceFlavour::robust) forces.reserve(n);
   AdMatrix k01_core = AdMatrix::Zero(), k10_core = AdMatrix::Zero();
-  EndpointMatrix meat = EndpointMatrix::Zero();
-  Block psi_core;  // [u J_r(-uX)^{-1}; t J_r(tX)^{-1}]
+  // The meat of the core Psi_i = [u J_r(-uX)^{-1}; t J_r(tX)^{-1}], by 6 x 6
+  // blocks: the start's, the cross term and the end's (its transpose is the
+  // fourth).
+  AdMatrix meat_start = AdMatrix::Zero(), meat_cross = AdMatrix::Zero(),
+           meat_end = AdMatrix::Zero();
   for (std::size_t i = 0; i < n; ++i) {
     const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
     if (w == 0) continue;
-    const AdMatrix start_inverse = right_jacobian_inverse<G>(Tangent(-u * x));
-    const AdMatrix end_inverse = right_jacobian_inverse<G>(Tangent(t * x));
-    const AdMatrix start_jacobian = right_jacobian<G>(Tangent(-u * x));
-    const AdMatrix end_jacobian = right_jacobian<G>(Tangent(t * x));
-    k01_core.noalias() += (w * t * u) * start_inverse * end_jacobian;
-    k10_core.noalias() += (w * t * u) * end_inverse * start_jacobian;
-    psi_core.template topRows<d>() = u * start_inverse;
-    psi_core.template bottomRows<d>() = t * end_inverse;
+    const RightJacobianPair<AdMatrix> start = right_jacobian_pair<G>(Tangent(-u * x));
+    const RightJacobianPair<AdMatrix> end = right_jacobian_pair<G>(Tangent(t * x));
+    // Small fixed-size products are written as lazy (coefficient-wise)
+    // products: Eigen's blocked kernels cost more than the arithmetic here.
+    const Scalar k_weight = w * t * u;
+    k01_core.noalias() += (k_weight * start.inverse).lazyProduct(end.jacobian);
+    k10_core.noalias() += (k_weight * end.inverse).lazyProduct(start.jacobian);
     if (flavour == CovarianceFlavour::homoscedastic) {
-      const Block spread = w * psi_core * s_root;
-      meat.template selfadjointView<Eigen::Lower>().rankUpdate(spread);
+      // w Psi_i S Psi_i^T w, with S = s_root s_root^T.
+      const AdMatrix start_spread = (w * u * start.inverse).lazyProduct(s_root);
+      const AdMatrix end_spread = (w * t * end.inverse).lazyProduct(s_root);
+      meat_start.noalias() += start_spread.lazyProduct(start_spread.transpose());
+      meat_cross.noalias() += start_spread.lazyProduct(end_spread.transpose());
+      meat_end.noalias() += end_spread.lazyProduct(end_spread.transpose());
     } else {
       const Vector2 l(u, t);
       const Scalar v = 1 - 2 * w * l.dot(h_inverse * l) + l.dot(leverage_matrix * l);
@@ -307,12 +310,24 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
                               " has leverage 1 (its residual is zero by construction): the "
                               "robust covariance is undefined");
       }
-      const ForceVector force = (w / sqrt(v)) * (psi_core * fit.residuals[i]);
-      meat.template selfadjointView<Eigen::Lower>().rankUpdate(force);
+      const Scalar force_weight = w / sqrt(v);
+      ForceVector force;
+      force.template head<d>() = (force_weight * u * start.inverse).lazyProduct(fit.residuals[i]);
+      force.template tail<d>() = (force_weight * t * end.inverse).lazyProduct(fit.residuals[i]);
+      meat_start.noalias() +=
+          force.template head<d>().lazyProduct(force.template head<d>().transpose());
+      meat_cross.noalias() +=
+          force.template head<d>().lazyProduct(force.template tail<d>().transpose());
+      meat_end.noalias() +=
+          force.template tail<d>().lazyProduct(force.template tail<d>().transpose());
       forces.push_back(force);
     }
   }
-  meat = meat.template selfadjointView<Eigen::Lower>();
+  EndpointMatrix meat;
+  meat.template topLeftCorner<d, d>() = meat_start;
+  meat.template topRightCorner<d, d>() = meat_cross;
+  meat.template bottomLeftCorner<d, d>() = meat_cross.transpose();
+  meat.template bottomRightCorner<d, d>() = meat_end;
 
   const AdMatrix identity = AdMatrix::Identity();
   const AdMatrix jacobian_back = right_jacobian<G>(Tangent(-x));
@@ -347,13 +362,14 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
     Eigen::Matrix<Scalar, d, 2 * d> velocity_map;
     velocity_map.template leftCols<d>() = -right_jacobian_inverse<G>(Tangent(-x));
     velocity_map.template rightCols<d>() = right_jacobian_inverse<G>(x);
-    result.effective.endpoints = covariance_detail::satterthwaite(EndpointMatrix(bread), forces);
+    result.effective.endpoints =
+        covariance_detail::satterthwaite(EndpointMatrix(bread), forces, meat);
     result.effective.start = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces);
-    result.effective.end =
-        covariance_detail::satterthwaite(Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces);
+        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces, meat);
+    result.effective.end = covariance_detail::satterthwaite(
+        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces, meat);
     result.effective.velocity = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces);
+        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces, meat);
   }
   result.status = CovarianceStatus::defined;
   result.flavour = flavour;

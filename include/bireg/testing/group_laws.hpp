@@ -76,11 +76,13 @@ struct GroupLawErrors {
   long double ad_conjugation = 0;    // exp(Ad_g x) = g exp(x) g^{-1}
   long double jacobian = 0;          // J_r(x) by central differences of exp
   long double jacobian_inverse = 0;  // J_r(x) J_r(x)^{-1} = I
+  long double jacobian_pair = 0;     // right_jacobian_pair = (J_r, J_r^{-1}) computed apart
   long double psi = 0;               // psi_s(ad x) r = s J_r(x) J_r(s x)^{-1} r
 
   long double worst() const {
     return std::max({log_of_exp, exp_of_log, inverse, associativity, ad_antisymmetry, ad_exp,
-                     ad_homomorphism, ad_conjugation, jacobian, jacobian_inverse, psi});
+                     ad_homomorphism, ad_conjugation, jacobian, jacobian_inverse, jacobian_pair,
+                     psi});
   }
 };
 
@@ -139,6 +141,10 @@ GroupLawErrors group_law_errors(std::mt19937& rng, int samples, double scale) {
     worse(e.jacobian, relative_difference(differences, jacobian));
     worse(e.jacobian_inverse, relative_difference(AdMatrix(jacobian * right_jacobian_inverse<G>(x)),
                                                   AdMatrix(AdMatrix::Identity())));
+    const RightJacobianPair<AdMatrix> pair = right_jacobian_pair<G>(x);
+    worse(e.jacobian_pair,
+          std::max(relative_difference(pair.jacobian, jacobian),
+                   relative_difference(pair.inverse, right_jacobian_inverse<G>(x))));
     for (const Scalar s : {Scalar(0.25), Scalar(0.5), Scalar(0.9)}) {
       const Tangent closed = apply_psi<G>(x, s, r);
       const Tangent through_jacobians =
