@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/regression/estimating_equations.hpp"
 #include "bireg/regression/iteration.hpp"
 #include "bireg/regression/problem.hpp"
@@ -45,7 +46,29 @@ struct RegressionDiagnostics {
   // are Euclidean in the tangent coordinates (which mix units on SE(3));
   // 1 when the data do not spread.
   Scalar explained_variance = 0;
+  // The largest rotation angle of a residual, measured by the spectral
+  // radius of ad_{r_i} (the rotation angle on SO(2), SO(3), SE(2), SE(3),
+  // the largest part's on products, 0 on R^n; on Sim(3) |sigma + i theta|,
+  // so a residual scale factor beyond e^{3 pi / 4} = 10.5 counts too), and
+  // its observation. Computed for groups that give
+  // the spectral radius in closed form (groups/capabilities.hpp); -1 and 0
+  // for the others. beyond_domain: the angle exceeds kBeyondDomainAngle =
+  // 3 pi / 4, i.e. an observation lies near the log's cut locus (pi) as
+  // seen from the fitted geodesic. Then the data turn by more than pi along
+  // the covariate (or that observation is a gross outlier), and the
+  // estimating equations, built on the principal log, no longer describe
+  // the data: a fit can converge there with a meaningless answer. Measured
+  // (tests/test_stability.cpp): such fits of data turning 3.2 to 13 rad
+  // end with angles of 2.99 to 3.14; noisy data within the domain stay at
+  // a few noise levels.
+  Scalar largest_residual_angle = 0;
+  std::ptrdiff_t largest_residual_observation = -1;
+  bool beyond_domain = false;
 };
+
+// Three quarters of the way to the cut locus of the principal log.
+template <class Scalar>
+constexpr Scalar kBeyondDomainAngle = Scalar(0.75L * 3.14159265358979323846264338327950288L);
 
 template <class G, class Rule>
 RegressionDiagnostics<typename G::Scalar> diagnose(
@@ -74,6 +97,17 @@ RegressionDiagnostics<typename G::Scalar> diagnose(
   d.residual_rms = sqrt(residual_sum / problem.weight_sum);
   d.residual_rms_about_mean = sqrt(spread / problem.weight_sum);
   d.explained_variance = spread > 0 ? 1 - residual_sum / spread : Scalar(1);
+  if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
+    for (std::size_t i = 0; i < residuals.size(); ++i) {
+      if (problem.w[i] == 0) continue;  // a zero weight takes the observation out of the fit
+      const Scalar angle = G::ad_spectral_radius(residuals[i]);
+      if (angle > d.largest_residual_angle) {
+        d.largest_residual_angle = angle;
+        d.largest_residual_observation = static_cast<std::ptrdiff_t>(i);
+      }
+    }
+    d.beyond_domain = d.largest_residual_angle > kBeyondDomainAngle<Scalar>;
+  }
   return d;
 }
 
