@@ -104,7 +104,8 @@ struct LocalEstimate {
   Scalar covariate = 0;                      // tau
   Status status = Status::invalid_input;     // of the local fit
   std::string message;                       // why, when not ok()
-  Element pose = G::identity();              // gamma_tau(tau)
+  Element pose = G::identity();              // gamma_tau(tau); of the last
+                                             // iterate when the fit failed
   Tangent velocity = Tangent::Zero();        // body velocity per covariate unit
   Tangent velocity_error = Tangent::Zero();  // its standard errors (0 if undefined)
   bool velocity_error_defined = false;
@@ -263,11 +264,15 @@ class LocalGeodesicRegression {
     estimate.status = fit.status;
     estimate.message = fit.message;
     estimate.iterations = fit.iterations;
-    if (!fit.ok() || !fit.geodesic) return estimate;
+    if (!fit.geodesic) return estimate;
+    // A failed fit still returns its last usable endpoints: the pose and
+    // velocity are reported with the failure's status, and the next query
+    // does not start from them.
     const Geodesic<G>& local = *fit.geodesic;
-    previous = local;
     estimate.pose = local(tau);
     estimate.velocity = local.body_velocity();
+    if (!fit.ok()) return estimate;
+    previous = local;
     if (options_.standard_errors) {
       const FitCovariance<G> c = covariance(fit, window.covariates, window.weights);
       if (c.defined()) {
