@@ -35,6 +35,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/confidence.hpp"
 #include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/robust.hpp"
 
 namespace bireg {
 
@@ -93,6 +94,17 @@ struct LocalRegressionOptions {
   // Compute the velocity's standard errors (statistics/covariance.hpp with
   // the kernel weights, homoscedastic).
   bool standard_errors = true;
+  // When set, every query is a robust fit (statistics/robust.hpp) of its
+  // window with the kernel weights as user weights, so an observation's
+  // weight is K((t_i - tau) / h) times its robust weight. The robust fit
+  // starts cold from the window's plain fit (its reweighting needs the
+  // plain residuals), so a query costs a few fits instead of one or two
+  // Gauss-Newton iterations. The standard errors then use the combined
+  // weights as if they were fixed: a plug-in that ignores the weights'
+  // dependence on the data. The robust weights depend on invariant
+  // Mahalanobis distances, so the local fit stays left and right
+  // equivariant.
+  std::optional<RobustOptions<Scalar>> robust;
 };
 
 template <class G>
@@ -109,10 +121,17 @@ struct LocalEstimate {
   Tangent velocity = Tangent::Zero();        // body velocity per covariate unit
   Tangent velocity_error = Tangent::Zero();  // its standard errors (0 if undefined)
   bool velocity_error_defined = false;
-  int iterations = 0;      // Gauss-Newton iterations of the local fit
+  int iterations = 0;      // Gauss-Newton iterations of the local fit(s)
   std::size_t window = 0;  // observations with positive weight
+  // With Options::robust: how the reweighting ended, its rounds, and the
+  // window's observations it flagged as outliers (their covariates).
+  std::optional<RobustStatus> robust_status;
+  int robust_rounds = 0;
+  std::vector<Scalar> outlier_covariates;
 
-  bool ok() const { return is_success(status); }
+  bool ok() const {
+    return is_success(status) && (!robust_status || *robust_status == RobustStatus::converged);
+  }
 };
 
 template <class G>
@@ -256,6 +275,7 @@ class LocalGeodesicRegression {
     const Scalar end_t = window.covariates.back();
     RegressionOptions<Scalar> fit_options = options_.fit;
     fit_options.interval = std::make_pair(start_t, end_t);
+    if (options_.robust) return robust_estimate_at(std::move(estimate), fit_options, window);
     const GeodesicRegression<G> regression(fit_options);
     const RegressionResult<G> fit =
         previous ? regression.fit_from({(*previous)(start_t), (*previous)(end_t)},
@@ -279,6 +299,34 @@ class LocalGeodesicRegression {
         estimate.velocity_error = standard_errors(velocity_covariance(c));
         estimate.velocity_error_defined = true;
       }
+    }
+    return estimate;
+  }
+
+  Estimate robust_estimate_at(Estimate estimate, const RegressionOptions<Scalar>& fit_options,
+                              const Window& window) const {
+    const RobustGeodesicRegression<G> regression(*options_.robust, fit_options);
+    const RobustResult<G> robust =
+        regression.fit(window.observations, window.covariates, window.weights);
+    estimate.status = robust.fit.status;
+    estimate.robust_status = robust.status;
+    estimate.robust_rounds = robust.rounds;
+    estimate.iterations = robust.fit_iterations;
+    estimate.message = robust.ok() ? robust.fit.message : robust.message;
+    for (const std::size_t i : robust.outliers)
+      estimate.outlier_covariates.push_back(window.covariates[i]);
+    if (!robust.fit.geodesic) return estimate;
+    const Geodesic<G>& local = *robust.fit.geodesic;
+    estimate.pose = local(estimate.covariate);
+    estimate.velocity = local.body_velocity();
+    if (!estimate.ok() || !options_.standard_errors) return estimate;
+    std::vector<Scalar> combined(window.weights.size());
+    for (std::size_t i = 0; i < combined.size(); ++i)
+      combined[i] = window.weights[i] * robust.robust_weights[i];
+    const FitCovariance<G> c = covariance(robust.fit, window.covariates, combined);
+    if (c.defined()) {
+      estimate.velocity_error = standard_errors(velocity_covariance(c));
+      estimate.velocity_error_defined = true;
     }
     return estimate;
   }
