@@ -24,11 +24,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
@@ -198,10 +202,52 @@ class LocalGeodesicRegression {
     std::optional<Geodesic<G>> previous;
     for (const std::size_t q : query_order) {
       const Scalar tau = queries[q];
-      fill_window(sorted_f, sorted_t, tau, reach, window);
+      fill_window(sorted_f, sorted_t, tau, reach, window, n);
       estimates[q] = estimate_at(tau, window, previous);
     }
     return estimates;
+  }
+
+  // Leave-one-out prediction errors: e_i = log(p_i^{-1} f_i), p_i the local
+  // estimate at t_i from all observations but i (at the ends, extrapolated
+  // along its window's geodesic), in input order. Left invariant; under
+  // right translation by h every e_i maps to Ad_{h^{-1}} e_i. Empty, with
+  // `problem` set, when a query fails (a window too narrow, or a local fit
+  // that does not converge). Cost: one local fit per observation.
+  template <class Observations, class Covariates>
+  std::vector<Tangent> leave_one_out(const Observations& observations, const Covariates& covariates,
+                                     std::string& problem) const {
+    problem = check(observations, covariates, {});
+    if (!problem.empty()) return {};
+    const std::size_t n = observations.size();
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return Scalar(covariates[a]) < Scalar(covariates[b]);
+    });
+    std::vector<Scalar> sorted_t(n);
+    std::vector<Element> sorted_f(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      sorted_t[i] = Scalar(covariates[order[i]]);
+      sorted_f[i] = observations[order[i]];
+    }
+    const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
+    Window window;
+    window.reserve(n);
+    std::optional<Geodesic<G>> previous;
+    std::vector<Tangent> errors(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      fill_window(sorted_f, sorted_t, sorted_t[i], reach, window, i);
+      const Estimate estimate = estimate_at(sorted_t[i], window, previous);
+      if (!estimate.ok()) {
+        problem =
+            "observation " + std::to_string(order[i]) + " left out: " +
+            (estimate.message.empty() ? std::string(to_string(estimate.status)) : estimate.message);
+        return {};
+      }
+      errors[order[i]] = G::log(G::compose(G::inverse(estimate.pose), sorted_f[i]));
+    }
+    return errors;
   }
 
  private:
@@ -243,13 +289,15 @@ class LocalGeodesicRegression {
   }
 
   // The observations with positive kernel weight at tau, ascending.
+  // `excluded`: a sorted index left out (leave-one-out), or n for none.
   void fill_window(const std::vector<Element>& f, const std::vector<Scalar>& t, Scalar tau,
-                   Scalar reach, Window& window) const {
+                   Scalar reach, Window& window, std::size_t excluded) const {
     window.clear();
     const auto first = std::lower_bound(t.begin(), t.end(), tau - reach);
     const auto last = std::upper_bound(t.begin(), t.end(), tau + reach);
     for (auto it = first; it != last; ++it) {
       const std::size_t i = static_cast<std::size_t>(it - t.begin());
+      if (i == excluded) continue;
       const Scalar weight = kernel_weight(options_.kernel, (t[i] - tau) / options_.bandwidth);
       if (!(weight > 0)) continue;
       window.observations.push_back(f[i]);
@@ -333,5 +381,96 @@ class LocalGeodesicRegression {
 
   Options options_;
 };
+
+// The automatic bandwidth: the cross-validation curve over a grid and its
+// minimiser.
+template <class Scalar>
+struct BandwidthSelection {
+  Scalar bandwidth = 0;      // the grid's value with the smallest criterion
+  std::vector<Scalar> grid;  // ascending
+  // The criterion per grid value: the generalised variance of the
+  // leave-one-out errors, det(S_h)^(1/d) with S_h = (1/N) sum e_i e_i^T.
+  // Left invariant; right translation multiplies every S_h by the same
+  // Ad S Ad^T, so the ratios and the choice are right invariant on every
+  // group (DESIGN.md section 5). Infinite where a query failed.
+  std::vector<Scalar> criterion;
+  // The mean squared error (1/N) sum |e_i|^2, for reading: left
+  // invariant, right invariant only on compact groups (SO(n)).
+  std::vector<Scalar> mean_squared_error;
+  std::vector<std::string> problems;  // why a grid value failed, else empty
+  bool ok() const { return bandwidth > 0; }
+};
+
+// `count` bandwidths, geometrically spaced from `smallest_spacings` median
+// sample spacings up to the covariates' whole range. Empty when the
+// covariates have fewer than two distinct values.
+template <class Covariates>
+std::vector<double> bandwidth_grid(const Covariates& covariates, int count = 20,
+                                   double smallest_spacings = 2) {
+  std::vector<double> t(covariates.begin(), covariates.end());
+  std::sort(t.begin(), t.end());
+  std::vector<double> spacings;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) spacings.push_back(t[i] - t[i - 1]);
+  }
+  if (spacings.empty() || count < 2) return {};
+  const auto middle = spacings.begin() + static_cast<std::ptrdiff_t>(spacings.size() / 2);
+  std::nth_element(spacings.begin(), middle, spacings.end());
+  const double low = smallest_spacings * *middle;
+  const double high = t.back() - t.front();
+  if (!(high > low)) return {high};
+  std::vector<double> grid(static_cast<std::size_t>(count));
+  const double ratio = std::log(high / low) / (count - 1);
+  for (int k = 0; k < count; ++k)
+    grid[static_cast<std::size_t>(k)] = low * std::exp(ratio * k);
+  return grid;
+}
+
+// Leave-one-out cross-validation over `grid` (options.bandwidth is
+// ignored). Cost: one local fit per observation per grid value, each over
+// its window: O(grid size x N x mean window), and a window of the whole
+// range costs O(N) per query, so the largest bandwidths dominate
+// (O(N^2) each); pass a shorter grid for long recordings.
+template <class G, class Observations, class Covariates>
+BandwidthSelection<typename G::Scalar> select_bandwidth(
+    const Observations& observations, const Covariates& covariates,
+    LocalRegressionOptions<typename G::Scalar> options,
+    const std::vector<typename G::Scalar>& grid) {
+  using Scalar = typename G::Scalar;
+  using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  BandwidthSelection<Scalar> selection;
+  selection.grid = grid;
+  std::sort(selection.grid.begin(), selection.grid.end());
+  options.standard_errors = false;
+  Scalar best = std::numeric_limits<Scalar>::infinity();
+  for (const Scalar h : selection.grid) {
+    options.bandwidth = h;
+    std::string problem;
+    const std::vector<typename G::Tangent> errors =
+        LocalGeodesicRegression<G>(options).leave_one_out(observations, covariates, problem);
+    Scalar criterion = std::numeric_limits<Scalar>::infinity();
+    Scalar mean_squared = std::numeric_limits<Scalar>::infinity();
+    if (problem.empty()) {
+      Scatter scatter = Scatter::Zero();
+      Scalar sum_squares = 0;
+      for (const auto& e : errors) {
+        scatter += e * e.transpose();
+        sum_squares += e.squaredNorm();
+      }
+      const Scalar count = Scalar(errors.size());
+      scatter /= count;
+      mean_squared = sum_squares / count;
+      criterion = std::pow(scatter.determinant(), Scalar(1) / Scalar(G::dof));
+    }
+    selection.criterion.push_back(criterion);
+    selection.mean_squared_error.push_back(mean_squared);
+    selection.problems.push_back(problem);
+    if (criterion < best) {
+      best = criterion;
+      selection.bandwidth = h;
+    }
+  }
+  return selection;
+}
 
 }  // namespace bireg
