@@ -209,8 +209,7 @@ TEST_CASE("bireg_smooth: bad usage gives exit 2 with the message and the usage",
   const std::string small = " \"" + data("so3_small.csv") + "\"";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--bandwidth 1" + small, "--group is required"},
-      {"--group SO3" + small, "--bandwidth is required"},
-      {"--group SO3 --bandwidth 0" + small, "--bandwidth needs a positive number"},
+      {"--group SO3 --bandwidth 0" + small, "--bandwidth needs a positive number or auto"},
       {"--group SO3 --bandwidth 1 --kernel box" + small, "unknown kernel 'box'"},
       {"--group SO3 --bandwidth 1 --rate -2" + small, "--rate needs a positive number"},
       {"--group SO3 --bandwidth 1 --rate 2 --at x.txt" + small, "--at and --rate exclude"},
@@ -370,4 +369,24 @@ TEST_CASE("bireg_smooth: reads TUM and writes the input's format, and write erro
       run_tool("--group SE3 --bandwidth 0.5 --velocity /nonexistent_dir/v.csv " + tum);
   REQUIRE(unwritable.exit_code == 4);
   REQUIRE(unwritable.err.find("/nonexistent_dir/v.csv: cannot write file") != std::string::npos);
+}
+
+TEST_CASE("bireg_smooth: --bandwidth auto chooses a bandwidth, says so, and smooths with it",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.4, -0.2, 0.3), 40);
+  const Run run =
+      run_tool("--group SO3 --bandwidth auto " + make_file("so3_geodesic_auto.csv", file.text));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.err.rfind("bireg_smooth: bandwidth auto: ", 0) == 0);
+  REQUIRE(run.err.find('\n') == run.err.size() - 1);
+  // A noise-free geodesic is recovered at any bandwidth: whichever was chosen.
+  const std::vector<Line> poses = parse_csv(run.out);
+  REQUIRE(poses.size() == 40);
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    REQUIRE((element_of<G>(poses[k].numbers) - file.at(static_cast<double>(k) / 10.0)).norm() <
+            1e-10);
+  }
 }

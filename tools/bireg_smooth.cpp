@@ -3,13 +3,17 @@
 //
 //   bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]
 //                [--times FILE] [--project]
-//                [--bandwidth H] [--kernel gaussian|epanechnikov|tricube]
+//                [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]
 //                [--at FILE | --rate HZ] [--velocity FILE]
 //                [--output FILE] [--output-format matrix|tum|euroc|kitti] FILE|-
 //
 // Input as bireg_fit (same formats, detection, --times and --project).
 // H is in seconds (frames for KITTI without --times); the kernels and the
-// Gaussian's truncation at 4 H are those of the library.
+// Gaussian's truncation at 4 H are those of the library. "auto" (the
+// default) chooses H by leave-one-out cross-validation (select_bandwidth)
+// over 20 values from 2 median sample spacings to the whole range, and
+// prints the choice as one line on stderr; it costs 20 smoothing passes,
+// the widest windows O(N^2) each (give H for long recordings).
 //
 // Where the trajectory is evaluated:
 //   default    at every input line's timestamp, in input order, each output
@@ -66,9 +70,12 @@ using bireg_cli::parse_number;
 constexpr const char* kUsage =
     "usage: bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]\n"
     "                    [--times FILE] [--project]\n"
-    "                    [--bandwidth H] [--kernel gaussian|epanechnikov|tricube]\n"
+    "                    [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]\n"
     "                    [--at FILE | --rate HZ] [--velocity FILE]\n"
     "                    [--output FILE] [--output-format matrix|tum|euroc|kitti] FILE|-\n";
+
+// Bandwidths tried by --bandwidth auto.
+constexpr int kAutoGridSize = 20;
 
 // More queries than this from --rate is a typing error, not a request.
 constexpr double kMaxRateQueries = 1e8;
@@ -76,7 +83,7 @@ constexpr double kMaxRateQueries = 1e8;
 struct Command {
   std::string group;
   bireg_cli::InputOptions input;
-  std::optional<double> bandwidth;
+  std::optional<double> bandwidth;  // empty: auto
   bireg::Kernel kernel = bireg::Kernel::gaussian;
   std::string at;
   std::optional<double> rate;
@@ -116,8 +123,13 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       command.input.times = v;
     } else if (arg == "--bandwidth") {
       double h = 0;
-      if (!parse_number(v, h) || !(h > 0)) return "--bandwidth needs a positive number";
-      command.bandwidth = h;
+      if (v == "auto") {
+        command.bandwidth.reset();
+      } else if (!parse_number(v, h) || !(h > 0)) {
+        return "--bandwidth needs a positive number or auto";
+      } else {
+        command.bandwidth = h;
+      }
     } else if (arg == "--kernel") {
       bool known = false;
       for (bireg::Kernel kernel :
@@ -143,7 +155,6 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     }
   }
   if (command.group.empty()) return "--group is required";
-  if (!command.bandwidth) return "--bandwidth is required";
   if (!command.at.empty() && command.rate) return "--at and --rate exclude each other";
   if (command.at == "-" && command.input.path == "-") {
     return "--at and the input cannot both be standard input";
@@ -286,7 +297,25 @@ int run(const Command& command) {
 
   bireg::LocalRegressionOptions<double> options;
   options.kernel = command.kernel;
-  options.bandwidth = *command.bandwidth;
+  if (command.bandwidth) {
+    options.bandwidth = *command.bandwidth;
+  } else {
+    const std::vector<double> grid = bireg::bandwidth_grid(trajectory.covariates, kAutoGridSize);
+    const bireg::BandwidthSelection<double> selection =
+        bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid);
+    if (!selection.ok()) {
+      return fail(name + ": no bandwidth from " + io::json_number(grid.front()) + " to " +
+                  io::json_number(grid.back()) +
+                  " s fits every leave-one-out window (the narrowest: " +
+                  selection.problems.front() + "): give --bandwidth H");
+    }
+    options.bandwidth = selection.bandwidth;
+    std::fprintf(stderr,
+                 "bireg_smooth: bandwidth auto: %s s (leave-one-out cross-validation over %zu "
+                 "values from %s to %s s)\n",
+                 io::json_number(selection.bandwidth).c_str(), grid.size(),
+                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
+  }
   const bireg::LocalGeodesicRegression<G> smoother(options);
   const std::vector<bireg::LocalEstimate<G>> estimates =
       smoother.smooth_at(trajectory.observations, trajectory.covariates, queries);
