@@ -177,6 +177,14 @@ TEST_CASE("bireg_smooth: every hostile input gives exit 2 and one line naming fi
       {"--bandwidth 1 \"" + data("equal_covariates.csv") + "\"",
        "equal_covariates.csv: all covariates are equal"},
       {"--bandwidth 1 \"" + data("no_such_file.csv") + "\"", "no_such_file.csv: cannot open file"},
+      {"--bandwidth 1 \"" + std::string(BIREG_TEST_DATA_DIR) + "\"",
+       "data: is a directory, not a file"},
+      {"--bandwidth 1 --format tum \"" + data("bad_quaternion.tum") + "\"",
+       "bad_quaternion.tum:2: quaternion norm 0.5 is far from 1"},
+      {"--bandwidth 1 --format tum \"" + data("wrong_columns.tum") + "\"",
+       "wrong_columns.tum:2: expected 8 numbers"},
+      {"--bandwidth 1 - < " + make_file("stdin_text.csv", "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\nx\n"),
+       "<stdin>:2: "},
       // so3_small.csv's timestamps are 2 + k 3/11: a bandwidth of 0.01 s
       // leaves every window with one observation, the first at line 3.
       {"--bandwidth 0.01 " + small, "so3_small.csv:3: fewer than two distinct covariates"},
