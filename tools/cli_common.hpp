@@ -144,4 +144,48 @@ std::optional<std::string> write_output(const std::string& path, bireg::io::Form
   return std::nullopt;
 }
 
+// Reads a file of query timestamps (bireg_smooth --at): one timestamp per
+// line in `unit` (the input trajectory's convention: seconds, or
+// nanoseconds for EuRoC), blank and '#' lines skipped, with each one's line
+// number. Returns the one-line message naming file and line when invalid.
+inline std::optional<std::string> read_query_times(const std::string& path,
+                                                   bireg::io::TimeUnit unit,
+                                                   std::vector<bireg::io::Timestamp>& times,
+                                                   std::vector<std::uint64_t>& lines) {
+  namespace io = bireg::io;
+  times.clear();
+  lines.clear();
+  std::string problem;
+  std::FILE* file = open_input(path, problem);
+  if (!file) return problem;
+  const std::string name = display_name(path);
+  io::FileSource source(file);
+  io::LineReader reader(source);
+  std::string_view line;
+  std::vector<std::string_view> tokens;
+  std::optional<std::string> error;
+  while (!error && reader.next(line)) {
+    io::split_tokens(line, tokens);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    if (tokens.size() != 1) {
+      error = where(name, reader.line_number()) + ": expected 1 timestamp, found " +
+              std::to_string(tokens.size()) + " numbers";
+      break;
+    }
+    io::Timestamp t;
+    if (auto bad = io::parse_timestamp(tokens[0], unit, t)) {
+      error = where(name, reader.line_number()) + ": " + *bad;
+      break;
+    }
+    times.push_back(std::move(t));
+    lines.push_back(reader.line_number());
+  }
+  if (!error && reader.error()) {
+    error = where(name, reader.error()->line) + ": " + reader.error()->message;
+  }
+  if (file != stdin) std::fclose(file);
+  if (!error && times.empty()) error = name + ": no timestamps";
+  return error;
+}
+
 }  // namespace bireg_cli

@@ -1,0 +1,400 @@
+// bireg_smooth, run as a user would: every hostile input class with exit 2
+// and one line naming file:line, noise-free geodesics smoothed to their
+// poses and velocity, --at and --rate timestamps, the --velocity CSV, and
+// the write-error exit code. Lean on purpose: only the groups' headers, no
+// regression templates (the library's behaviour is tested in
+// test_local_regression.cpp).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/so3.hpp"
+#include "catch.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+fs::path work_dir() {
+  const fs::path dir = fs::path(BIREG_TEST_WORK_DIR);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string data(const std::string& name) {
+  return std::string(BIREG_TEST_DATA_DIR) + "/" + name;
+}
+
+// A file in the work directory holding `text`; its path, quoted.
+std::string make_file(const std::string& name, const std::string& text) {
+  const fs::path path = work_dir() / name;
+  std::ofstream(path, std::ios::binary) << text;
+  return "\"" + path.string() + "\"";
+}
+
+Run run_tool(const std::string& arguments) {
+  // ctest runs test cases in parallel processes: one pair of files each.
+  const std::string tag = std::to_string(static_cast<long>(getpid()));
+  const fs::path out = work_dir() / ("stdout_" + tag + ".txt");
+  const fs::path err = work_dir() / ("stderr_" + tag + ".txt");
+  const std::string command = std::string("\"") + BIREG_SMOOTH_EXECUTABLE + "\" " + arguments +
+                              " > \"" + out.string() + "\" 2> \"" + err.string() + "\"";
+  const int status = std::system(command.c_str());
+  Run run;
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.out = slurp(out);
+  run.err = slurp(err);
+  return run;
+}
+
+std::vector<std::string> split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::stringstream stream(text);
+  std::string part;
+  while (std::getline(stream, part, separator))
+    parts.push_back(part);
+  // getline drops a trailing empty field ("1,2," is three fields).
+  if (!text.empty() && text.back() == separator && separator != '\n') parts.emplace_back();
+  return parts;
+}
+
+// The lines of a matrix-format output: the timestamp text and the numbers.
+struct Line {
+  std::string time;
+  std::vector<double> numbers;
+};
+
+std::vector<Line> parse_csv(const std::string& text) {
+  std::vector<Line> lines;
+  for (const std::string& row : split(text, '\n')) {
+    if (row.empty()) continue;
+    const std::vector<std::string> fields = split(row, ',');
+    Line line;
+    line.time = fields[0];
+    // An empty field (an undefined standard error) reads as NaN.
+    for (std::size_t k = 1; k < fields.size(); ++k) {
+      line.numbers.push_back(fields[k].empty() ? std::nan("")
+                                               : std::strtod(fields[k].c_str(), nullptr));
+    }
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+template <class G>
+typename G::Element element_of(const std::vector<double>& numbers) {
+  typename G::Element g;
+  const int n = static_cast<int>(g.rows());
+  REQUIRE(numbers.size() == static_cast<std::size_t>(n * n));
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c)
+      g(r, c) = numbers[static_cast<std::size_t>(r * n + c)];
+  }
+  return g;
+}
+
+std::string number_text(double x) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
+}
+
+// A noise-free geodesic g(t) = g0 exp((t - 100) X) at t = 100 + k / 10,
+// k < n, in the matrix format, timestamps written as exact decimals.
+template <class G>
+struct GeodesicFile {
+  typename G::Element g0;
+  typename G::Tangent velocity;
+  double origin = 100;
+  std::string text;
+
+  typename G::Element at(double seconds_after_origin) const {
+    return g0 * G::exp(seconds_after_origin * velocity);
+  }
+};
+
+template <class G>
+GeodesicFile<G> geodesic_file(const typename G::Tangent& start, const typename G::Tangent& velocity,
+                              int n) {
+  GeodesicFile<G> file;
+  file.g0 = G::exp(start);
+  file.velocity = velocity;
+  for (int k = 0; k < n; ++k) {
+    const typename G::Element g = file.at(k / 10.0);
+    file.text += std::to_string(100 + k / 10) + "." + std::to_string(k % 10);
+    for (int r = 0; r < g.rows(); ++r) {
+      for (int c = 0; c < g.cols(); ++c)
+        file.text += ", " + number_text(g(r, c));
+    }
+    file.text += '\n';
+  }
+  return file;
+}
+
+}  // namespace
+
+TEST_CASE("bireg_smooth: every hostile input gives exit 2 and one line naming file:line",
+          "[tool]") {
+  struct Case {
+    std::string args, expected;
+  };
+  const std::string small = "\"" + data("so3_small.csv") + "\"";
+  const std::vector<Case> cases = {
+      {"--bandwidth 1 \"" + data("truncated.csv") + "\"",
+       "truncated.csv:3: expected 10 numbers, found 9"},
+      {"--bandwidth 1 \"" + data("text_in_number.csv") + "\"",
+       "text_in_number.csv:2: not a number: 'abc'"},
+      {"--bandwidth 1 \"" + data("not_in_group.csv") + "\"",
+       "not_in_group.csv:2: matrix is not an element of SO3"},
+      {"--bandwidth 1 \"" + data("nan.csv") + "\"", "nan.csv:2: not a finite number: 'nan'"},
+      {"--bandwidth 1 \"" + data("huge.csv") + "\"", "huge.csv:3: number out of range: '1e400'"},
+      {"--bandwidth 1 \"" + data("extra_columns.csv") + "\"",
+       "extra_columns.csv:3: expected 10 numbers, found 11"},
+      {"--bandwidth 1 \"" + data("empty.csv") + "\"", "empty.csv: no observations"},
+      {"--bandwidth 1 \"" + data("one_observation.csv") + "\"",
+       "one_observation.csv: need at least 2 observations, got 1"},
+      {"--bandwidth 1 \"" + data("equal_covariates.csv") + "\"",
+       "equal_covariates.csv: all covariates are equal"},
+      {"--bandwidth 1 \"" + data("no_such_file.csv") + "\"", "no_such_file.csv: cannot open file"},
+      {"--bandwidth 1 \"" + std::string(BIREG_TEST_DATA_DIR) + "\"",
+       "data: is a directory, not a file"},
+      {"--bandwidth 1 --format tum \"" + data("bad_quaternion.tum") + "\"",
+       "bad_quaternion.tum:2: quaternion norm 0.5 is far from 1"},
+      {"--bandwidth 1 --format tum \"" + data("wrong_columns.tum") + "\"",
+       "wrong_columns.tum:2: expected 8 numbers"},
+      {"--bandwidth 1 - < " + make_file("stdin_text.csv", "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\nx\n"),
+       "<stdin>:2: "},
+      // so3_small.csv's timestamps are 2 + k 3/11: a bandwidth of 0.01 s
+      // leaves every window with one observation, the first at line 3.
+      {"--bandwidth 0.01 " + small, "so3_small.csv:3: fewer than two distinct covariates"},
+      {"--bandwidth 1 --at " + make_file("at_text.txt", "2.5\nabc\n") + " " + small,
+       "at_text.txt:2: not a number: 'abc'"},
+      {"--bandwidth 1 --at " + make_file("at_two.txt", "# t\n2.5 3\n") + " " + small,
+       "at_two.txt:2: expected 1 timestamp, found 2 numbers"},
+      {"--bandwidth 1 --at " + make_file("at_nan.txt", "2.5\n3\nnan\n") + " " + small,
+       "at_nan.txt:3: not a finite number: 'nan'"},
+      {"--bandwidth 1 --at " + make_file("at_empty.txt", "# none\n") + " " + small,
+       "at_empty.txt: no timestamps"},
+      {"--bandwidth 1 --at " + make_file("at_after.txt", "2.5\n5.0000001\n") + " " + small,
+       "at_after.txt:2: timestamp '5.0000001' is outside the data's range [2, 5]"},
+      {"--bandwidth 1 --at " + make_file("at_before.txt", "1.999\n") + " " + small,
+       "at_before.txt:1: timestamp '1.999' is outside the data's range"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Run run = run_tool("--group SO3 " + c.args);
+    CAPTURE(run.err);
+    REQUIRE(run.exit_code == 2);
+    REQUIRE(run.out.empty());
+    REQUIRE(run.err.rfind("bireg_smooth: ", 0) == 0);
+    REQUIRE(run.err.find(c.expected) != std::string::npos);
+    REQUIRE(run.err.find('\n') == run.err.size() - 1);
+  }
+}
+
+TEST_CASE("bireg_smooth: bad usage gives exit 2 with the message and the usage", "[tool]") {
+  const std::string small = " \"" + data("so3_small.csv") + "\"";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--bandwidth 1" + small, "--group is required"},
+      {"--group SO3 --bandwidth 0" + small, "--bandwidth needs a positive number or auto"},
+      {"--group SO3 --bandwidth 1 --kernel box" + small, "unknown kernel 'box'"},
+      {"--group SO3 --bandwidth 1 --rate -2" + small, "--rate needs a positive number"},
+      {"--group SO3 --bandwidth 1 --rate 2 --at x.txt" + small, "--at and --rate exclude"},
+      {"--group SO4 --bandwidth 1" + small, "unknown group 'SO4'"},
+      {"--group SE2 --bandwidth 1 --output-format tum" + small,
+       "the tum format holds SE3 or SO3 poses, not SE2"},
+  };
+  for (const auto& [args, expected] : cases) {
+    CAPTURE(args);
+    const Run run = run_tool(args);
+    CAPTURE(run.err);
+    REQUIRE(run.exit_code == 2);
+    REQUIRE(run.out.empty());
+    REQUIRE(run.err.find(expected) != std::string::npos);
+  }
+}
+
+// Tolerance: the local fit of noise-free geodesic data converges to the
+// geodesic itself (the estimating equations vanish there); what is left is
+// rounding in the matrices written with 17 digits and in the fit, a few
+// 1e-16 times the ~20 observations per window, far below 1e-10.
+TEST_CASE("bireg_smooth: a noise-free SO3 geodesic is smoothed to its poses and velocity",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.8, -0.4, 1.1), 60);
+  const std::string input = make_file("so3_geodesic.csv", file.text);
+  const fs::path velocity = work_dir() / "so3_velocity.csv";
+  // Bandwidths whose windows (4 h wide for the Gaussian, 2 h for the
+  // others) turn through about 1.2 rad at |X| = 1.4 rad/s: well inside the
+  // estimator's domain (less than pi end to end).
+  const std::vector<std::pair<std::string, std::string>> kernels = {
+      {"gaussian", "0.2"}, {"epanechnikov", "0.4"}, {"tricube", "0.4"}};
+  for (const auto& [kernel, bandwidth] : kernels) {
+    CAPTURE(kernel);
+    const Run run = run_tool("--group SO3 --bandwidth " + bandwidth + " --kernel " + kernel +
+                             " --velocity \"" + velocity.string() + "\" " + input);
+    CAPTURE(run.err);
+    REQUIRE(run.exit_code == 0);
+    const std::vector<Line> poses = parse_csv(run.out);
+    const std::vector<Line> input_lines = parse_csv(file.text);
+    REQUIRE(poses.size() == input_lines.size());
+    const std::vector<std::string> csv = split(slurp(velocity), '\n');
+    REQUIRE(csv.at(0) == "t,wx,wy,wz,se_wx,se_wy,se_wz");
+    const std::vector<Line> velocities = parse_csv(slurp(velocity).substr(csv.at(0).size() + 1));
+    REQUIRE(velocities.size() == poses.size());
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      // The input's timestamp text, exactly.
+      REQUIRE(poses[k].time == input_lines[k].time);
+      REQUIRE(velocities[k].time == input_lines[k].time);
+      const double t = static_cast<double>(k) / 10.0;
+      REQUIRE((element_of<G>(poses[k].numbers) - file.at(t)).norm() < 1e-10);
+      REQUIRE(velocities[k].numbers.size() == 6);
+      for (int i = 0; i < 3; ++i) {
+        REQUIRE(std::abs(velocities[k].numbers[static_cast<std::size_t>(i)] - file.velocity[i]) <
+                1e-10);
+        // No residuals: the standard error is undefined (an empty field,
+        // never NaN in the file) or at the rounding level.
+        const double error = velocities[k].numbers[static_cast<std::size_t>(3 + i)];
+        REQUIRE((std::isnan(error) || std::abs(error) < 1e-10));
+      }
+    }
+  }
+}
+
+TEST_CASE("bireg_smooth: SE3 velocity columns are translation first, as the group's tangent",
+          "[tool]") {
+  using G = bireg::SE3<double>;
+  G::Tangent start, velocity;
+  start << 0.5, -1.0, 2.0, 0.2, 0.4, -0.3;
+  velocity << 1.5, -0.25, 0.75, 0.3, -0.9, 0.6;
+  const GeodesicFile<G> file = geodesic_file<G>(start, velocity, 40);
+  const fs::path csv = work_dir() / "se3_velocity.csv";
+  const Run run = run_tool("--group SE3 --bandwidth 0.3 --velocity \"" + csv.string() + "\" " +
+                           make_file("se3_geodesic.csv", file.text));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::string text = slurp(csv);
+  const std::string header = split(text, '\n').at(0);
+  REQUIRE(header == "t,vx,vy,vz,wx,wy,wz,se_vx,se_vy,se_vz,se_wx,se_wy,se_wz");
+  const std::vector<Line> rows = parse_csv(text.substr(header.size() + 1));
+  REQUIRE(rows.size() == 40);
+  const std::vector<Line> poses = parse_csv(run.out);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    REQUIRE((element_of<G>(poses[k].numbers) - file.at(static_cast<double>(k) / 10.0)).norm() <
+            1e-10);
+    for (int i = 0; i < 6; ++i)
+      REQUIRE(std::abs(rows[k].numbers[static_cast<std::size_t>(i)] - velocity[i]) < 1e-10);
+  }
+}
+
+TEST_CASE("bireg_smooth: --at evaluates between samples and keeps the file's timestamp text",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.1, 0.2, 0.3), G::Tangent(-0.5, 0.9, 0.2), 50);
+  const std::string input = make_file("so3_geodesic_at.csv", file.text);
+  // In the input's convention (seconds, as the file's first column), in any
+  // order, with the first and last sample's times included (the range is
+  // closed) and spellings that must come back unchanged.
+  const std::vector<std::string> at = {"103.250", "100", "104.9", "101.0500", "1.0205e2"};
+  std::string at_text = "# query times\n";
+  for (const std::string& t : at)
+    at_text += t + "\n";
+  const Run run =
+      run_tool("--group SO3 --bandwidth 0.3 --at " + make_file("at.txt", at_text) + " " + input);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::vector<Line> poses = parse_csv(run.out);
+  REQUIRE(poses.size() == at.size());
+  for (std::size_t q = 0; q < at.size(); ++q) {
+    CAPTURE(at[q]);
+    REQUIRE(poses[q].time == at[q]);
+    const double t = std::strtod(at[q].c_str(), nullptr) - file.origin;
+    REQUIRE((element_of<G>(poses[q].numbers) - file.at(t)).norm() < 1e-10);
+  }
+}
+
+TEST_CASE("bireg_smooth: --rate resamples from the first timestamp, exactly", "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.1, 0.2, 0.3), G::Tangent(-0.5, 0.9, 0.2), 50);
+  const Run run = run_tool("--group SO3 --bandwidth 0.3 --rate 4 " +
+                           make_file("so3_geodesic_rate.csv", file.text));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::vector<Line> poses = parse_csv(run.out);
+  // 100 to 104.9 s at 4 Hz: 100, 100.25, ..., 104.75.
+  REQUIRE(poses.size() == 20);
+  REQUIRE(poses[0].time == "100");
+  REQUIRE(poses[1].time == "100.25");
+  REQUIRE(poses[19].time == "104.75");
+  for (std::size_t q = 0; q < poses.size(); ++q) {
+    REQUIRE((element_of<G>(poses[q].numbers) - file.at(static_cast<double>(q) / 4.0)).norm() <
+            1e-10);
+  }
+}
+
+TEST_CASE("bireg_smooth: reads TUM and writes the input's format, and write errors exit 4",
+          "[tool]") {
+  const std::string tum = "\"" + data("se3_small.tum") + "\"";
+  const Run run = run_tool("--group SE3 --bandwidth 0.5 " + tum);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::vector<std::string> in = split(slurp(data("se3_small.tum")), '\n');
+  const std::vector<std::string> out = split(run.out, '\n');
+  std::vector<std::string> in_times;
+  for (const std::string& line : in) {
+    if (!line.empty() && line[0] != '#') in_times.push_back(split(line, ' ').at(0));
+  }
+  REQUIRE(out.size() == in_times.size());
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    REQUIRE(split(out[k], ' ').size() == 8);
+    REQUIRE(split(out[k], ' ')[0] == in_times[k]);
+  }
+  const Run unwritable =
+      run_tool("--group SE3 --bandwidth 0.5 --velocity /nonexistent_dir/v.csv " + tum);
+  REQUIRE(unwritable.exit_code == 4);
+  REQUIRE(unwritable.err.find("/nonexistent_dir/v.csv: cannot write file") != std::string::npos);
+}
+
+TEST_CASE("bireg_smooth: --bandwidth auto chooses a bandwidth, says so, and smooths with it",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.4, -0.2, 0.3), 40);
+  const Run run =
+      run_tool("--group SO3 --bandwidth auto " + make_file("so3_geodesic_auto.csv", file.text));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.err.rfind("bireg_smooth: bandwidth auto: ", 0) == 0);
+  REQUIRE(run.err.find('\n') == run.err.size() - 1);
+  // A noise-free geodesic is recovered at any bandwidth: whichever was chosen.
+  const std::vector<Line> poses = parse_csv(run.out);
+  REQUIRE(poses.size() == 40);
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    REQUIRE((element_of<G>(poses[k].numbers) - file.at(static_cast<double>(k) / 10.0)).norm() <
+            1e-10);
+  }
+}
