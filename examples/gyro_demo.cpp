@@ -20,8 +20,8 @@
 //     spacing (the Gaussian's window then holds 9 samples) to 0.25 s (wider
 //     windows turn through more than pi on this recording).
 // Prints the RMS error |w - w_gyro| over all samples (rad/s) and the chosen
-// bandwidths; writes the CSV `gyro_demo_plot.csv` (or argv[1]): seconds
-// 20 to 23 with the gyroscope, finite differences and bireg at 0.02 rad.
+// bandwidths; draws `gyro_demo.svg` (or argv[1]): seconds 20 to 22 with the
+// gyroscope, finite differences and bireg at 0.02 rad.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,10 +29,12 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "svg_plot.hpp"
 
 namespace {
 
@@ -138,27 +140,45 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   return out;
 }
 
-// The plot's data: t, gyroscope, finite differences and bireg (x, y, z
-// each) over [from, to] seconds.
-bool write_plot_csv(const std::string& path, double from, double to, const std::vector<double>& t,
-                    const std::vector<Vector3>& gyro, const std::vector<Vector3>& differences,
-                    const std::vector<Vector3>& smoothed) {
-  std::FILE* out = std::fopen(path.c_str(), "w");
-  if (!out) {
-    std::fprintf(stderr, "gyro_demo: cannot write %s\n", path.c_str());
-    return false;
-  }
-  std::fprintf(out, "t,gyro_x,gyro_y,gyro_z,fd_x,fd_y,fd_z,bireg_x,bireg_y,bireg_z\n");
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < from || t[i] > to) continue;
-    std::fprintf(out, "%.6f", t[i]);
-    for (const auto* series : {&gyro, &differences, &smoothed}) {
-      for (int k = 0; k < 3; ++k)
-        std::fprintf(out, ",%.6f", (*series)[i][k]);
+// The picture: over [from, to] seconds, one panel per axis with the
+// gyroscope, finite differences and bireg (body angular velocity, rad/s).
+bool write_plot_svg(const std::string& path, double from, double to, double noise,
+                    const std::vector<double>& t, const std::vector<Vector3>& gyro,
+                    const std::vector<Vector3>& differences, const std::vector<Vector3>& smoothed) {
+  const char* axes[] = {"x", "y", "z"};
+  bireg_plot::Figure figure;
+  figure.title = "x-IMU: body angular velocity from orientation alone, against the gyroscope";
+  char subtitle[120];
+  std::snprintf(subtitle, sizeof subtitle,
+                "orientation noise %g rad added; bireg at the cross-validated bandwidth", noise);
+  figure.subtitle = subtitle;
+  for (int k = 0; k < 3; ++k) {
+    bireg_plot::Series gyro_series{"gyroscope", "#444444", {}, {}, false, false};
+    bireg_plot::Series difference_series{"finite differences", "#ff7f0e", {}, {}, false, true};
+    bireg_plot::Series bireg_series{"bireg", "#1f77b4", {}, {}, false, false};
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] < from || t[i] > to) continue;
+      for (auto [series, values] :
+           {std::pair{&gyro_series, &gyro}, std::pair{&difference_series, &differences},
+            std::pair{&bireg_series, &smoothed}}) {
+        series->x.push_back(t[i]);
+        series->y.push_back((*values)[i][k]);
+      }
     }
-    std::fprintf(out, "\n");
+    bireg_plot::Panel panel;
+    panel.title = std::string("about the sensor's ") + axes[k] + " axis";
+    panel.x_label = "time";
+    panel.x_unit = "s";
+    panel.y_label = std::string("w") + axes[k];
+    panel.y_unit = "rad/s";
+    panel.series = {difference_series, gyro_series, bireg_series};
+    figure.panels.push_back(panel);
   }
-  return std::fclose(out) == 0;
+  std::ofstream out(path);
+  out << bireg_plot::render_svg(figure);
+  out.close();
+  if (!out) std::fprintf(stderr, "gyro_demo: cannot write %s\n", path.c_str());
+  return static_cast<bool>(out);
 }
 
 }  // namespace
@@ -188,7 +208,7 @@ int main(int argc, char** argv) {
   std::printf("|---|---|---|---|---|\n");
   std::mt19937 rng(20261123);
   std::normal_distribution<double> normal(0.0, 1.0);
-  const std::string plot_path = argc > 1 ? argv[1] : "gyro_demo_plot.csv";
+  const std::string plot_path = argc > 1 ? argv[1] : "gyro_demo.svg";
   for (const double noise : {0.0, 0.005, 0.02}) {
     std::vector<SO3::Element> noisy = raw;
     for (SO3::Element& r : noisy) {
@@ -205,11 +225,11 @@ int main(int argc, char** argv) {
     std::printf("| %g | %.3f | %.3f | %.4f | %.2f |\n", noise, rms_error(differences, reference),
                 rms_error(smoothed.velocity, reference), smoothed.bandwidth,
                 smoothed.mean_iterations);
-    if (noise == 0.02 &&
-        !write_plot_csv(plot_path, 20.0, 23.0, t, reference, differences, smoothed.velocity)) {
+    if (noise == 0.02 && !write_plot_svg(plot_path, 20.0, 22.0, noise, t, reference, differences,
+                                         smoothed.velocity)) {
       return 1;
     }
   }
-  std::printf("\nplot data (20-23 s, noise 0.02 rad): %s\n", plot_path.c_str());
+  std::printf("\nplot (20-22 s, noise 0.02 rad): %s\n", plot_path.c_str());
   return 0;
 }

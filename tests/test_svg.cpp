@@ -373,3 +373,16 @@ TEST_CASE("The demo's pictures in docs/ are well-formed, with round ticks and un
     CHECK(svg.find(" fit</text>") != std::string::npos);
   }
 }
+
+TEST_CASE("The gyroscope demo's picture in docs/ is well-formed, with round ticks and units") {
+  const std::string svg = read_file(std::string(BIREG_DOCS_DIR) + "/gyro_demo.svg");
+  REQUIRE(!svg.empty());
+  const auto problem = not_well_formed(svg);
+  INFO((problem ? *problem : std::string("well-formed")));
+  REQUIRE(!problem);
+  check_labels_and_fonts(svg);
+  CHECK(svg.find("time [s]") != std::string::npos);
+  CHECK(svg.find("[rad/s]") != std::string::npos);
+  for (const char* legend : {">gyroscope</text>", ">finite differences</text>", ">bireg</text>"})
+    CHECK(svg.find(legend) != std::string::npos);
+}
