@@ -38,6 +38,8 @@
 #include <cmath>
 #include <string>
 
+#include "bireg/statistics/distributions.hpp"
+
 namespace bireg {
 
 enum class Loss { huber, cauchy, tukey };
@@ -159,20 +161,6 @@ inline double tuning_constant(Loss loss, int p, double efficiency = 0.95) {
     (gaussian_efficiency(loss, middle, p) < efficiency ? low : high) = middle;
   }
   return 0.5 * (low + high);
-}
-
-// The regularised lower incomplete gamma function P(s, x), by its power
-// series x^s e^{-x} / Gamma(s + 1) sum_k x^k / ((s+1)...(s+k)), which
-// converges for every x (terms shrink once k > x); used for the chi-square
-// CDF P(p/2, q/2) at the moderate arguments needed here.
-inline double regularized_gamma_p(double s, double x) {
-  if (x <= 0) return 0.0;
-  double term = 1.0, sum = 1.0;
-  for (int k = 1; k < 1000 && term > 1e-17 * sum; ++k) {
-    term *= x / (s + k);
-    sum += term;
-  }
-  return std::min(1.0, std::exp(s * std::log(x) - x - std::lgamma(s + 1)) * sum);
 }
 
 // The quantile q with P(chi^2_p <= q) = probability, by bisection.
