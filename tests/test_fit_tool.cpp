@@ -25,6 +25,11 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/confidence.hpp"
+#include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/explained_variance.hpp"
+#include "bireg/statistics/mean.hpp"
+#include "bireg/statistics/trend_test.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
@@ -736,4 +741,281 @@ TEST_CASE("bireg_fit: directories, binary input, long lines and write errors", "
     REQUIRE(WEXITSTATUS(status) == 4);
     REQUIRE(slurp(scratch("full_err.txt")).find("<stdout>: write error") != std::string::npos);
   }
+}
+
+namespace {
+
+// The JSON from the first occurrence of `key` on, so that json_numbers
+// finds a key that several sections share ("homoscedastic") in the right one.
+std::string section(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\":");
+  REQUIRE(at != std::string::npos);
+  return json.substr(at);
+}
+
+// Largest entry of |a - b| over the largest |b|.
+template <class Matrix>
+double relative_difference(const std::vector<double>& a, const Matrix& b) {
+  REQUIRE(a.size() == static_cast<std::size_t>(b.size()));
+  double largest = 0, difference = 0;
+  for (int k = 0; k < b.size(); ++k) {
+    // Row-major in the JSON, column-major in Eigen: symmetric matrices and
+    // vectors only.
+    largest = std::max(largest, std::abs(b(k)));
+    difference = std::max(difference, std::abs(a[static_cast<std::size_t>(k)] - b(k)));
+  }
+  return difference / largest;
+}
+
+// The library's fit of the SE3 sample, with the tool's --tol 1e-14.
+bireg::RegressionResult<bireg::SE3<double>> library_fit(
+    const bireg::io::Trajectory<bireg::SE3<double>>& trajectory) {
+  bireg::GeodesicRegression<bireg::SE3<double>>::Options options;
+  options.tolerance = 1e-14;
+  const auto fit = bireg::GeodesicRegression<bireg::SE3<double>>(options).fit(
+      trajectory.observations, trajectory.covariates);
+  REQUIRE(fit.ok());
+  return fit;
+}
+
+}  // namespace
+
+// The tool and the test compute the same quantities from endpoints that
+// agree to 1e-12 (see check_against_library); the covariance is a smooth
+// function of endpoints and residuals (size 0.02 here), so it moves by at
+// most ~1e-12 / 0.02 = 5e-11 relative: 1e-9 leaves margin.
+TEST_CASE("bireg_fit --confidence: covariance, standard errors and R^2 are the library's",
+          "[tool][confidence]") {
+  using G = bireg::SE3<double>;
+  const Sample sample = make_sample(40);
+  const std::string file = scratch("confidence.csv");
+  write_text(file, write_sample(sample, bireg::io::Format::matrix));
+  const Run run = run_tool("--group SE3 --tol 1e-14 --confidence 0.9 " + quoted(file));
+  CAPTURE(run.err, run.out);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE_FALSE(json_has_non_finite(run.out));
+  const std::string confidence = section(run.out, "confidence");
+  REQUIRE(json_numbers(confidence, "level").at(0) == 0.9);
+
+  const auto trajectory = read_file<G>(file, bireg::io::Format::matrix);
+  const auto fit = library_fit(trajectory);
+  const auto plain = bireg::covariance(fit, trajectory.covariates);
+  const auto robust =
+      bireg::covariance(fit, trajectory.covariates, {}, bireg::CovarianceFlavour::robust);
+  REQUIRE(plain.status == bireg::CovarianceStatus::defined);
+  REQUIRE(robust.status == bireg::CovarianceStatus::defined);
+
+  const std::string endpoints = section(confidence, "endpoint_covariance");
+  REQUIRE(relative_difference(json_numbers(endpoints, "homoscedastic"), plain.endpoints) <= 1e-9);
+  REQUIRE(relative_difference(json_numbers(endpoints, "heteroscedasticity_robust"),
+                              robust.endpoints) <= 1e-9);
+  // The two flavours differ (else the test could not tell them apart).
+  REQUIRE((plain.endpoints - robust.endpoints).norm() > 1e-3 * plain.endpoints.norm());
+
+  const std::string velocity_se = section(confidence, "velocity_standard_error");
+  REQUIRE(relative_difference(json_numbers(velocity_se, "homoscedastic"),
+                              bireg::standard_errors(bireg::velocity_covariance(plain))) <= 1e-9);
+  REQUIRE(relative_difference(json_numbers(velocity_se, "heteroscedasticity_robust"),
+                              bireg::standard_errors(bireg::velocity_covariance(robust))) <= 1e-9);
+  // The velocity per second: the displacement over the 0.39 s the sample spans.
+  const Eigen::Matrix<double, 6, 1> velocity =
+      fit.geodesic->displacement() / (trajectory.covariates.back() - trajectory.covariates.front());
+  REQUIRE(relative_difference(json_numbers(confidence, "velocity"), velocity) <= 1e-9);
+
+  // Unit weights: nu = N - 2 (textbook), up to rounding of the weight sums.
+  REQUIRE(std::abs(json_numbers(section(confidence, "degrees_of_freedom"), "homoscedastic").at(0) -
+                   38) <= 1e-9);
+
+  const auto mean = bireg::mean<G>(trajectory.observations);
+  const auto explained = bireg::explained_variance(fit, mean);
+  REQUIRE(explained.defined);
+  const std::string variance = section(confidence, "explained_variance");
+  REQUIRE(std::abs(json_numbers(variance, "r_squared").at(0) - explained.euclidean) <= 1e-9);
+  REQUIRE(std::abs(json_numbers(variance, "wilks_lambda").at(0) - explained.wilks_lambda) <=
+          1e-9 * explained.wilks_lambda);
+}
+
+TEST_CASE("bireg_fit --confidence: an undefined covariance is a message and exit code 5",
+          "[tool][confidence]") {
+  // N = 2: no degrees of freedom. N = 3 on a geodesic (rotations about x
+  // by 0, a and 2a, cos a = 0.8, sin a = 0.6, cos 2a = 0.28, sin 2a = 0.96):
+  // residuals at rounding level, which the covariance reports as vanishing.
+  const std::string two = "0, 1,0,0, 0,1,0, 0,0,1\n1, 1,0,0, 0,0.8,-0.6, 0,0.6,0.8\n";
+  const std::string three = two + "2, 1,0,0, 0,0.28,-0.96, 0,0.96,0.28\n";
+  for (const std::string& text : {two, three}) {
+    const std::string file = scratch("undefined.csv");
+    write_text(file, text);
+    const std::string band = scratch("undefined_band.csv");
+    fs::remove(band);
+    const Run run = run_tool("--group SO3 --confidence 0.95 --output-band " + quoted(band) + " " +
+                             quoted(file));
+    CAPTURE(text, run.out, run.err);
+    REQUIRE(run.exit_code == 5);
+    REQUIRE(json_string(run.out, "status") == "converged");
+    REQUIRE(run.out.find("\"covariance_defined\": false") != std::string::npos);
+    REQUIRE(json_string(run.out, "message").find("undefined") != std::string::npos);
+    REQUIRE(run.out.find("\"endpoint_covariance\"") == std::string::npos);
+    REQUIRE_FALSE(json_has_non_finite(run.out));
+    REQUIRE_FALSE(fs::exists(band));
+    REQUIRE(run.err.find("not written") != std::string::npos);
+  }
+}
+
+TEST_CASE("bireg_fit refuses bad --confidence, --permutations and --seed", "[tool][confidence]") {
+  const std::string file = quoted(data("so3_small.csv"));
+  for (const std::string& args :
+       {std::string("--confidence 0"), std::string("--confidence 1"),
+        std::string("--confidence -0.5"), std::string("--confidence 95"),
+        std::string("--permutations 0"), std::string("--permutations -10"),
+        std::string("--permutations 9.5"), std::string("--seed 3"),
+        std::string("--permutations 9 --seed -1")}) {
+    const Run run = run_tool("--group SO3 " + args + " " + file);
+    CAPTURE(args, run.err);
+    REQUIRE(run.exit_code == 2);
+    REQUIRE(run.out.empty());
+    const std::string option = args.substr(0, args.find(' '));
+    REQUIRE(run.err.rfind("bireg_fit: ", 0) == 0);
+    REQUIRE(run.err.find(args.find("--seed") != std::string::npos ? "--seed" : option) !=
+            std::string::npos);
+  }
+}
+
+// The p-value is (1 + k) / (B + 1) with k an integer count: the tool and the
+// library, with the same seed, draw the same permutations, so k agrees
+// exactly (a Lambda_b tied with Lambda to rounding would be needed to flip
+// a comparison, which continuous data make improbable).
+TEST_CASE("bireg_fit --permutations: the library's p-value, reproducible by seed",
+          "[tool][trend]") {
+  using G = bireg::SE3<double>;
+  const Sample sample = make_sample(40);
+  const std::string file = scratch("trend.csv");
+  write_text(file, write_sample(sample, bireg::io::Format::matrix));
+  const int b = 49;
+  const Run first = run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 " + quoted(file));
+  const Run second = run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 " + quoted(file));
+  CAPTURE(first.err, first.out);
+  REQUIRE(first.exit_code == 0);
+  REQUIRE(second.exit_code == 0);
+  REQUIRE_FALSE(json_has_non_finite(first.out));
+  const std::string test = section(first.out, "trend_test");
+  const double p = json_numbers(test, "p_value").at(0);
+  REQUIRE(p == json_numbers(section(second.out, "trend_test"), "p_value").at(0));
+  REQUIRE(json_numbers(test, "permutations").at(0) == b);
+  REQUIRE(json_numbers(test, "seed").at(0) == 7);
+
+  const auto trajectory = read_file<G>(file, bireg::io::Format::matrix);
+  bireg::GeodesicRegression<G>::Options options;
+  options.tolerance = 1e-14;
+  bireg::TrendTestOptions test_options;
+  test_options.permutations = b;
+  test_options.seed = 7;
+  const auto expected =
+      bireg::trend_test(bireg::GeodesicRegression<G>(options), trajectory.observations,
+                        trajectory.covariates, {}, test_options);
+  REQUIRE(expected.ok());
+  REQUIRE(p == expected.p_value);
+  REQUIRE(std::abs(json_numbers(test, "wilks_lambda").at(0) - expected.statistic) <=
+          1e-9 * expected.statistic);
+  // The sample moves ~2 (tangent units) against noise 0.02: no permutation
+  // comes near, so p is the smallest possible value.
+  REQUIRE(p == 1.0 / (b + 1));
+}
+
+TEST_CASE("bireg_fit --output-band: exact timestamps, the fitted poses, a band narrowest inside",
+          "[tool][confidence]") {
+  using G = bireg::SE3<double>;
+  const Sample sample = make_sample(40);
+  const std::string file = scratch("band_input.csv");
+  write_text(file, write_sample(sample, bireg::io::Format::matrix));
+  const std::string band = scratch("band.csv");
+  const Run run =
+      run_tool("--group SE3 --tol 1e-14 --output-band " + quoted(band) + " " + quoted(file));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  std::ifstream in(band);
+  std::string header;
+  REQUIRE(std::getline(in, header));
+  REQUIRE(header.rfind("timestamp,m00,m01,", 0) == 0);
+  REQUIRE(header.find(",half_width_trans_x,") != std::string::npos);
+  REQUIRE(header.find(",half_width_rot_z_deg") != std::string::npos);
+
+  const auto trajectory = read_file<G>(file, bireg::io::Format::matrix);
+  const auto fit = library_fit(trajectory);
+  const auto c = bireg::covariance(fit, trajectory.covariates);
+  const double q = *bireg::pose_quantile(c, 0.95);
+  std::vector<double> sizes;  // |half-widths| per row
+  std::string line;
+  for (std::size_t i = 0; std::getline(in, line); ++i) {
+    REQUIRE(i < sample.poses.size());
+    const auto fields = split_exact(line, ',');
+    REQUIRE(fields.size() == 1 + 16 + 6);
+    REQUIRE(fields[0] == sample.seconds[i]);
+    const G::Element pose = (*fit.geodesic)(trajectory.covariates[i]);
+    for (int k = 0; k < 16; ++k)
+      REQUIRE(std::abs(std::stod(fields[1 + static_cast<std::size_t>(k)]) - pose(k / 4, k % 4)) <=
+              1e-9);
+    const Eigen::Matrix<double, 6, 1> widths =
+        bireg::half_widths(bireg::pose_covariance(c, trajectory.covariates[i]), q);
+    Eigen::Matrix<double, 6, 1> written;
+    for (int k = 0; k < 6; ++k)
+      written[k] = std::stod(fields[17 + static_cast<std::size_t>(k)]);
+    // Rotation half-widths are written in degrees.
+    written.tail<3>() *= 3.14159265358979323846 / 180;
+    REQUIRE((written - widths).norm() <= 1e-9 * widths.norm());
+    sizes.push_back(written.norm());
+  }
+  REQUIRE(sizes.size() == sample.poses.size());
+  // The band of a line fitted to evenly spread covariates is narrowest near
+  // their centre and widest at the ends (the OLS variance of the line's
+  // value is quadratic in t with its minimum at the mean covariate).
+  const double middle = sizes[sizes.size() / 2];
+  REQUIRE(middle < sizes.front());
+  REQUIRE(middle < sizes.back());
+}
+
+// Issue 15: one pose replaced by a gross error (rotated by pi/2, moved by
+// 2 units) among 30 near an SE3 geodesic with noise 0.01. The plain fit is
+// pulled by ~1/30 of the error (~0.05); Tukey's fit gives the outlier
+// weight 0 and stays at the noise level (~0.01 / sqrt(30) per endpoint).
+TEST_CASE("bireg_fit --loss names the planted outlier's line and fits closer to the truth",
+          "[tool][robust]") {
+  using G = bireg::SE3<double>;
+  std::mt19937 rng(5);
+  G::Tangent x;
+  x << 1.0, -0.5, 0.3, 0.4, 0.2, -0.3;
+  const G::Element g0 = G::exp((G::Tangent() << 0.2, 0.1, -0.3, 0.1, 0.5, 0.2).finished());
+  const G::Element g1 = g0 * G::exp(x);
+  const int n = 30, bad = 12;
+  std::string text = "# a comment line, so that line numbers differ from indices\n";
+  for (int i = 0; i < n; ++i) {
+    const double u = static_cast<double>(i) / (n - 1);
+    G::Element pose =
+        g0 * G::exp(u * x) * G::exp(bireg_test::random_tangent<G::Tangent>(rng, 0.01));
+    if (i == bad)
+      pose = pose * G::exp((G::Tangent() << 2.0, 0, 0, 0, 1.5707963267948966, 0).finished());
+    text += g17(u);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        text += ", " + g17(pose(r, c));
+    text += "\n";
+  }
+  const std::string file = scratch("outlier.csv");
+  write_text(file, text);
+  const Run plain = run_tool("--group SE3 " + quoted(file));
+  const Run robust = run_tool("--group SE3 --loss tukey " + quoted(file));
+  CAPTURE(robust.err, robust.out);
+  REQUIRE(plain.exit_code == 0);
+  REQUIRE(robust.exit_code == 0);
+  // Line 1 is the comment: observation i is on line i + 2.
+  const std::vector<double> lines = json_numbers(robust.out, "outlier_lines");
+  REQUIRE(lines == std::vector<double>{bad + 2});
+  const auto distance = [](const std::vector<double>& json, const G::Element& truth) {
+    return G::log(G::inverse(truth) * element_of<G>(json)).norm();
+  };
+  const double plain_error =
+      distance(json_numbers(plain.out, "g0"), g0) + distance(json_numbers(plain.out, "g1"), g1);
+  const double robust_error =
+      distance(json_numbers(robust.out, "g0"), g0) + distance(json_numbers(robust.out, "g1"), g1);
+  CAPTURE(plain_error, robust_error);
+  REQUIRE(robust_error < plain_error / 2);
 }

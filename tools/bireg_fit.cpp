@@ -6,6 +6,7 @@
 //             [--solver paper|optimal_linear|preconditioned|gauss_newton]
 //             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--loss huber|cauchy|tukey [--loss-scale C]]
+//             [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]] FILE|-
 //
 // The formats, their detection when --format is omitted, --times and
@@ -19,15 +20,44 @@
 // efficiency); the JSON then has a "robust" object with the flagged
 // outliers' input line numbers, and exit code 3 when it did not converge.
 //
+// For SO3 and SE3 (refused for the other groups, with a message):
+// --confidence LEVEL (0 < LEVEL < 1) adds a "confidence" object: the body
+// velocity and its standard errors (per covariate unit, i.e. per second),
+// the 2d x 2d covariance of the left-trivialised endpoint perturbations in
+// both flavours ("homoscedastic": one residual covariance for all
+// observations; "heteroscedasticity_robust": the HC2 sandwich), their
+// degrees of freedom, and the explained variances against the bi-invariant
+// mean (R^2 and Wilks' form); bireg/statistics/covariance.hpp,
+// confidence.hpp and explained_variance.hpp. --permutations B (B >= 1)
+// [--seed S] (default 0) adds a "trend_test" object: Wilks' Lambda and the
+// permutation p-value of "f does not depend on t" (trend_test.hpp).
+// --output-band FILE writes a CSV (tools/fit_report.hpp documents the
+// columns) of the fitted pose and its homoscedastic confidence
+// half-widths at every input timestamp, at the --confidence level (0.95
+// if not given). With --loss the covariance treats the final robust
+// weights as fixed design weights: a flagged outlier then inflates
+// neither the fit nor its covariance (the weights' own dependence on the
+// data is ignored, as in the usual IRLS sandwich); the trend test permutes
+// the plain fit (the robust weights depend on the covariates, so
+// permuting them with fixed weights would not be exchangeable).
+// Statistics that are undefined (N = 2, zero residuals, ...) are reported
+// in the JSON by "covariance_defined": false (or "defined": false) and a
+// "message", never by NaN or null, and give exit code 5
+// (the band file is then not written).
+//
 // Prints one JSON object on stdout. Exit codes: 0 converged, 2 invalid input
 // or usage (one line on stderr naming file, line and problem), 3 the fit did
 // not converge (the JSON is still printed, with its status), 4 the output
-// could not be written (disk full, closed pipe, ...).
+// could not be written (disk full, closed pipe, ...), 5 the fit converged
+// but a requested statistic is undefined (the JSON says why).
 #include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bireg/groups/matrix_group.hpp"
@@ -39,6 +69,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/robust.hpp"
 #include "cli_common.hpp"
+#include "fit_report.hpp"
 
 namespace {
 
@@ -48,6 +79,9 @@ using bireg_cli::kExitWriteError;
 using bireg_cli::parse_count;
 using bireg_cli::parse_number;
 
+// The fit converged but a statistic asked for is undefined.
+constexpr int kExitUndefined = 5;
+
 constexpr const char* kUsage =
     "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]\n"
     "                 [--times FILE] [--project]\n"
@@ -55,6 +89,7 @@ constexpr const char* kUsage =
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
     "                 [--step LAMBDA] [--tol X] [--max-iter K]\n"
     "                 [--loss huber|cauchy|tukey [--loss-scale C]]\n"
+    "                 [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]\n"
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
     "                 FILE|-\n";
 
@@ -71,6 +106,10 @@ struct Command {
   std::optional<bireg::io::Format> output_format;  // empty: the input's
   std::optional<bireg::Loss> loss;
   double loss_scale = 0;  // 0: the 95%-efficiency default
+  std::optional<double> confidence;
+  int permutations = 0;  // 0: no trend test
+  std::optional<int> seed;
+  std::string output_band;
 };
 
 int fail(const std::string& message) {
@@ -156,6 +195,24 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       if (!parse_number(*v, command.loss_scale) || !(command.loss_scale > 0)) {
         return "--loss-scale needs a positive number";
       }
+    } else if (arg == "--confidence") {
+      double level = 0;
+      if (!parse_number(*v, level) || !(level > 0 && level < 1)) {
+        return "--confidence needs a level strictly between 0 and 1, got '" + *v + "'";
+      }
+      command.confidence = level;
+    } else if (arg == "--permutations") {
+      double count = 0;
+      if (!parse_number(*v, count) || count != std::floor(count) || count < 1 || count > 1e9) {
+        return "--permutations needs an integer B >= 1, got '" + *v + "'";
+      }
+      command.permutations = static_cast<int>(count);
+    } else if (arg == "--seed") {
+      int seed = 0;
+      if (!parse_count(*v, seed)) return "--seed needs an integer in [0, 1e9], got '" + *v + "'";
+      command.seed = seed;
+    } else if (arg == "--output-band") {
+      command.output_band = *v;
     } else if (arg == "--output-trajectory") {
       command.output_trajectory = *v;
     } else {
@@ -173,10 +230,67 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     return "--order applies to --method series only";
   }
   if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
+  if (command.seed && command.permutations == 0) return "--seed goes with --permutations B";
   return std::nullopt;
 }
 
 using bireg::io::json_number;
+
+// The groups whose fits get --confidence, --permutations and --output-band.
+template <class G>
+constexpr bool kHasStatistics =
+    std::is_same_v<G, bireg::SO3<double>> || std::is_same_v<G, bireg::SE3<double>>;
+
+// Computes the statistics asked for, writes the band file and fills the
+// JSON sections; returns 0, kExitUndefined (a statistic is undefined: the
+// JSON says why) or kExitWriteError (the band file could not be written).
+template <class G>
+int statistics(const Command& command,
+               const typename bireg::GeodesicRegression<G>::Options& options,
+               const bireg::io::Trajectory<G>& trajectory, const bireg::RegressionResult<G>& result,
+               const std::optional<bireg::RobustResult<G>>& robust, std::string& confidence_json,
+               std::string& trend_json) {
+  using Regression = bireg::GeodesicRegression<G>;
+  bool undefined = false;
+  const std::vector<double> weights = robust ? robust->robust_weights : std::vector<double>();
+  const bool wants_covariance = command.confidence || !command.output_band.empty();
+  const double level = command.confidence.value_or(0.95);
+  if (wants_covariance) {
+    const auto covariances =
+        bireg_fit_report::covariances<G>(result, trajectory.covariates, weights);
+    if (command.confidence) {
+      const auto mean = bireg::mean<G>(trajectory.observations, weights);
+      bool defined = false;
+      confidence_json = bireg_fit_report::confidence_json(covariances, result, mean, weights, level,
+                                                          robust.has_value(), defined);
+      undefined = undefined || !defined;
+    }
+    if (!command.output_band.empty()) {
+      if (!covariances.defined()) {
+        std::fprintf(stderr, "bireg_fit: %s: not written: %s\n", command.output_band.c_str(),
+                     covariances.problem.c_str());
+        undefined = true;
+      } else if (auto error = bireg_fit_report::write_band(command.output_band, trajectory,
+                                                           covariances.homoscedastic, level)) {
+        std::fprintf(stderr, "bireg_fit: %s\n", error->c_str());
+        return kExitWriteError;
+      }
+    }
+  }
+  if (command.permutations > 0) {
+    bireg::TrendTestOptions test_options;
+    test_options.permutations = command.permutations;
+    test_options.seed = static_cast<std::uint64_t>(command.seed.value_or(0));
+    const auto test = bireg::trend_test(Regression(options), trajectory.observations,
+                                        trajectory.covariates, {}, test_options);
+    bool defined = false;
+    trend_json =
+        bireg_fit_report::trend_test_json(test, command.permutations, test_options.seed, defined);
+    undefined = undefined || !defined;
+  }
+
+  return undefined ? kExitUndefined : 0;
+}
 
 template <class G>
 int run(const Command& command) {
@@ -232,6 +346,26 @@ int run(const Command& command) {
     }
   }
 
+  // The statistics, computed before anything is printed so that the band
+  // file and the JSON agree; for the pose and orientation groups only, as
+  // each group instantiates the whole statistics layer (minutes of compile
+  // time per group).
+  const bool wants_statistics =
+      command.confidence || command.permutations > 0 || !command.output_band.empty();
+  bool undefined = false;
+  std::string confidence_json, trend_json;
+  if constexpr (kHasStatistics<G>) {
+    if (wants_statistics && result.ok()) {
+      const int outcome =
+          statistics(command, options, trajectory, result, robust, confidence_json, trend_json);
+      if (outcome == kExitWriteError) return kExitWriteError;
+      undefined = outcome == kExitUndefined;
+    }
+  } else if (wants_statistics) {
+    return fail(std::string("--confidence, --permutations and --output-band are available for "
+                            "SO3 and SE3, not ") +
+                G::name);
+  }
   const auto& d = result.diagnostics;
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
   const std::string projection =
@@ -269,6 +403,8 @@ int run(const Command& command) {
         bireg::to_string(robust->loss), json_number(robust->loss_scale).c_str(),
         bireg::to_string(robust->status), robust->rounds, lines.c_str());
   }
+  if (!confidence_json.empty()) std::printf(",\n \"confidence\": %s", confidence_json.c_str());
+  if (!trend_json.empty()) std::printf(",\n \"trend_test\": %s", trend_json.c_str());
   std::printf("}\n");
   errno = 0;
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
@@ -276,7 +412,8 @@ int run(const Command& command) {
                  errno != 0 ? std::strerror(errno) : "unknown");
     return kExitWriteError;
   }
-  return result.ok() && (!robust || robust->ok()) ? 0 : kExitNotConverged;
+  if (!result.ok() || (robust && !robust->ok())) return kExitNotConverged;
+  return undefined ? kExitUndefined : 0;
 }
 
 }  // namespace
