@@ -1019,3 +1019,115 @@ TEST_CASE("bireg_fit --loss names the planted outlier's line and fits closer to 
   CAPTURE(plain_error, robust_error);
   REQUIRE(robust_error < plain_error / 2);
 }
+
+// Data turning far beyond pi (issue 19): among simulated recordings that
+// turn 6 to 12 rad, the first whose fit converges (checked with the library,
+// so the test does not rest on one lucky seed) must come out of the tool
+// with "beyond_domain": true and a warning naming the farthest line.
+TEST_CASE("bireg_fit reports a converged fit of data turning beyond pi", "[tool]") {
+  using G = bireg::SO3<double>;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    G::Tangent x(normal(rng), normal(rng), normal(rng));
+    x *= (6.0 + 6.0 * attempt / 50.0) / x.norm();
+    std::vector<G::Element> f;
+    std::vector<double> t;
+    std::string text;
+    for (int i = 0; i < 50; ++i) {
+      const double s = i / 49.0;
+      f.push_back(G::exp(G::Tangent(s * x)) *
+                  G::exp(bireg_test::random_tangent<G::Tangent>(rng, 0.01)));
+      t.push_back(s);
+      text += g17(s);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          text += ", " + g17(f.back()(r, c));
+      text += "\n";
+    }
+    const auto fit = bireg::GeodesicRegression<G>().fit(f, t);
+    if (!fit.ok()) continue;
+    REQUIRE(fit.diagnostics.beyond_domain);
+    const std::string file = scratch("beyond_pi.csv");
+    write_text(file, text);
+    const Run run = run_tool("--group SO3 " + quoted(file));
+    CAPTURE(run.out, run.err);
+    REQUIRE(run.exit_code == 0);
+    REQUIRE(run.out.find("\"beyond_domain\": true") != std::string::npos);
+    const std::string line =
+        std::to_string(fit.diagnostics.largest_residual_observation + 1);  // no comment lines
+    REQUIRE(run.err.find("beyond_pi.csv:" + line + ": warning:") != std::string::npos);
+    return;
+  }
+  FAIL("no recording turning beyond pi converged: the test exercised nothing");
+}
+
+// --group auto (issue 18): scenes simulated from one model each (N = 60,
+// noise 0.01 rad and 0.01 m, motion over 10 noise levels, as in
+// test_model_selection.cpp, where the selector recovers them in 198-200 of
+// 200 replicates) must come back with that model recommended, the
+// five-row table, and the recommended model's prediction written out.
+namespace {
+std::string tum_scene(bool rotates, bool translates, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  std::string text = "# timestamp tx ty tz qx qy qz qw\n";
+  for (int i = 0; i < 60; ++i) {
+    const double t = 1.7e9 + 0.1 * i;
+    const double u = i / 59.0;
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(rotates ? 1.2 * u : 0.0, axis).toRotationMatrix() *
+        bireg::SO3<double>::exp(Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    const Eigen::Vector3d p = Eigen::Vector3d(1.0, 2.0, 0.5) +
+                              (translates ? u : 0.0) * Eigen::Vector3d(3.0, -1.0, 0.2) +
+                              Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const Eigen::Quaterniond q(r);
+    text += g17(t) + " " + g17(p.x()) + " " + g17(p.y()) + " " + g17(p.z()) + " " + g17(q.x()) +
+            " " + g17(q.y()) + " " + g17(q.z()) + " " + g17(q.w()) + "\n";
+  }
+  return text;
+}
+}  // namespace
+
+TEST_CASE("bireg_fit --group auto recommends the generating model and writes its fit",
+          "[tool][model_selection]") {
+  struct Scene {
+    bool rotates, translates;
+    const char* model;
+  };
+  for (const Scene scene :
+       {Scene{true, false, "rotation_only"}, Scene{false, true, "translation_only"},
+        Scene{false, false, "static"}}) {
+    CAPTURE(scene.model);
+    const std::string file = scratch(std::string("auto_") + scene.model + ".tum");
+    write_text(file, tum_scene(scene.rotates, scene.translates, 3));
+    const std::string out = scratch(std::string("auto_fit_") + scene.model + ".tum");
+    const Run run =
+        run_tool("--group auto --output-trajectory " + quoted(out) + " " + quoted(file));
+    CAPTURE(run.out, run.err);
+    REQUIRE(run.exit_code == 0);
+    REQUIRE(json_string(run.out, "recommended") == scene.model);
+    std::size_t rows = 0;
+    for (std::size_t at = run.out.find("{\"model\": "); at != std::string::npos;
+         at = run.out.find("{\"model\": ", at + 1))
+      ++rows;
+    REQUIRE(rows == 5);
+    REQUIRE_FALSE(json_has_non_finite(run.out));
+    // The written prediction: 60 poses at the input's timestamps; for a
+    // scene that does not translate, every predicted position is the
+    // fixed one to within the noise's mean (0.01 / sqrt(60) per axis, 5
+    // sigma allowed).
+    const auto fitted = read_file<bireg::SE3<double>>(out, bireg::io::Format::tum);
+    REQUIRE(fitted.observations.size() == 60);
+    if (!scene.translates) {
+      for (const auto& pose : fitted.observations)
+        REQUIRE((pose.topRightCorner<3, 1>() - Eigen::Vector3d(1.0, 2.0, 0.5)).norm() <=
+                5 * 0.01 / std::sqrt(60.0) * std::sqrt(3.0));
+    }
+  }
+  const std::string file = scratch("auto_static.tum");
+  const Run refused = run_tool("--group auto --loss tukey " + quoted(file));
+  REQUIRE(refused.exit_code == 2);
+  REQUIRE(refused.err.find("--group auto takes") != std::string::npos);
+}

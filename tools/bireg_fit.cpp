@@ -1,6 +1,6 @@
 // bireg_fit: fit a bi-invariant geodesic to a trajectory file.
 //
-//   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]
+//   bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3|auto [--format matrix|tum|euroc|kitti]
 //             [--times FILE] [--project]
 //             [--method exact|series|series_adaptive] [--order M]
 //             [--solver paper|optimal_linear|preconditioned|gauss_newton]
@@ -12,6 +12,9 @@
 // The formats, their detection when --format is omitted, --times and
 // --project are described in include/bireg/io/formats.hpp and README.md.
 // Sim3 (4x4 [s R t; 0 1]), SL3 and GLp3 (3x3) read the matrix format only.
+// --group auto reads SE(3) poses and chooses the motion model they need
+// (tools/fit_auto.hpp); it takes the input options and --output-trajectory
+// / --output-format only.
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
 //
@@ -50,6 +53,7 @@
 // not converge (the JSON is still printed, with its status), 4 the output
 // could not be written (disk full, closed pipe, ...), 5 the fit converged
 // but a requested statistic is undefined (the JSON says why).
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -69,6 +73,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/robust.hpp"
 #include "cli_common.hpp"
+#include "fit_auto.hpp"
 #include "fit_report.hpp"
 
 namespace {
@@ -83,7 +88,8 @@ using bireg_cli::parse_number;
 constexpr int kExitUndefined = 5;
 
 constexpr const char* kUsage =
-    "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3 [--format matrix|tum|euroc|kitti]\n"
+    "usage: bireg_fit --group SO2|SO3|SE2|SE3|Sim3|SL3|GLp3|auto [--format "
+    "matrix|tum|euroc|kitti]\n"
     "                 [--times FILE] [--project]\n"
     "                 [--method exact|series|series_adaptive] [--order M]\n"
     "                 [--solver paper|optimal_linear|preconditioned|gauss_newton]\n"
@@ -367,6 +373,24 @@ int run(const Command& command) {
                 G::name);
   }
   const auto& d = result.diagnostics;
+  // A converged fit whose residuals reach near the log's cut locus answers
+  // nothing (regression/diagnostics.hpp): say so on stderr, with the line,
+  // unless the robust fit has already set that observation aside.
+  const std::uint64_t farthest_line =
+      d.largest_residual_observation >= 0
+          ? trajectory.lines[static_cast<std::size_t>(d.largest_residual_observation)]
+          : 0;
+  const bool farthest_is_outlier =
+      robust &&
+      std::find(robust->outliers.begin(), robust->outliers.end(),
+                static_cast<std::size_t>(d.largest_residual_observation)) != robust->outliers.end();
+  if (d.beyond_domain && result.ok() && !farthest_is_outlier) {
+    std::fprintf(stderr,
+                 "bireg_fit: %s: warning: this observation lies %.3g rad from the fitted "
+                 "geodesic, beyond 3 pi/4: the data turn by more than pi along the covariate "
+                 "(or it is a gross outlier), outside the estimator's domain\n",
+                 bireg_cli::where(name, farthest_line).c_str(), double(d.largest_residual_angle));
+  }
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
   const std::string projection =
       command.input.project
@@ -380,7 +404,9 @@ int run(const Command& command) {
       "\"contraction_factor\": %s, \"method\": \"%s\", \"series_order\": %d, \"solver\": \"%s\", "
       "\"backtracks\": %d, "
       "\"force_norm\": %s, "
-      "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s}",
+      "\"residual_rms\": %s, \"residual_rms_about_mean\": %s, \"explained_variance\": %s, "
+      "\"largest_residual_angle\": %s, \"largest_residual_line\": %llu, "
+      "\"beyond_domain\": %s}",
       G::name, io::to_string(trajectory.format), trajectory.observations.size(), projection.c_str(),
       io::json_matrix(result.geodesic->start()).c_str(),
       io::json_matrix(result.geodesic->end()).c_str(),
@@ -391,7 +417,9 @@ int run(const Command& command) {
       json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(),
       bireg::to_string(command.method), d.series_order, bireg::to_string(command.solver),
       d.backtracks, json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
-      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str());
+      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str(),
+      json_number(d.largest_residual_angle).c_str(), static_cast<unsigned long long>(farthest_line),
+      d.beyond_domain ? "true" : "false");
   if (robust) {
     std::string lines;  // the flagged observations' line numbers in the input
     for (std::size_t i : robust->outliers) {
@@ -424,6 +452,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bireg_fit: %s\n%s", error->c_str(), kUsage);
     return kExitInvalid;
   }
+  if (command.group == "auto") {
+    const bool fit_options = command.loss || command.confidence || command.permutations > 0 ||
+                             !command.output_band.empty();
+    if (fit_options) {
+      std::fprintf(stderr,
+                   "bireg_fit: --group auto takes the input options and --output-trajectory "
+                   "only (--loss, --confidence, --permutations and --output-band need an "
+                   "explicit group)\n%s",
+                   kUsage);
+      return kExitInvalid;
+    }
+    return bireg_cli::run_auto({command.input, command.output_trajectory, command.output_format});
+  }
   if (command.group == "SO2") return run<bireg::SO2<double>>(command);
   if (command.group == "SO3") return run<bireg::SO3<double>>(command);
   if (command.group == "SE2") return run<bireg::SE2<double>>(command);
@@ -431,7 +472,8 @@ int main(int argc, char** argv) {
   if (command.group == "Sim3") return run<bireg::Sim3<double>>(command);
   if (command.group == "SL3") return run<bireg::SL3<double>>(command);
   if (command.group == "GLp3") return run<bireg::GLp<3, double>>(command);
-  std::fprintf(stderr, "bireg_fit: unknown group '%s' (SO2, SO3, SE2, SE3, Sim3, SL3 or GLp3)\n%s",
+  std::fprintf(stderr,
+               "bireg_fit: unknown group '%s' (SO2, SO3, SE2, SE3, Sim3, SL3, GLp3 or auto)\n%s",
                command.group.c_str(), kUsage);
   return kExitInvalid;
 }

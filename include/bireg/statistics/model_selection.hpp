@@ -279,6 +279,16 @@ inline double floored_log_det(const Eigen::Matrix<double, 6, 6>& s, double floor
 
 }  // namespace model_selection_detail
 
+// One candidate fitted alone: its prediction P(t) at any covariate (what
+// bireg_fit --group auto writes for the recommended model), or nothing if
+// its fit failed.
+using MotionPrediction = model_selection_detail::Predictor;
+template <class Poses>
+std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses& poses,
+                                                 const std::vector<double>& times) {
+  return model_selection_detail::fit_model(model, poses, times);
+}
+
 // Compare the five pose-motion models on `poses` (indexable 4x4 SE(3)
 // matrices with size()) at covariates `times`. Never throws for bad data,
 // never returns NaN: a model that cannot be fitted (N below its parameter
