@@ -32,48 +32,20 @@
 #include "bireg/statistics/trend_test.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
+#include "tool_runner.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+using bireg_test::data;
+using bireg_test::Run;
+using bireg_test::slurp;
+using bireg_test::work_dir;
 
 bool json_has_non_finite(const std::string& json);
 
-struct Run {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-fs::path work_dir() {
-  const fs::path dir = fs::path(BIREG_TEST_WORK_DIR);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string data(const std::string& name) {
-  return std::string(BIREG_TEST_DATA_DIR) + "/" + name;
-}
-
 Run run_tool(const std::string& arguments) {
-  // ctest runs test cases in parallel processes: one pair of files each.
-  const std::string tag = std::to_string(static_cast<long>(getpid()));
-  const fs::path out = work_dir() / ("stdout_" + tag + ".txt");
-  const fs::path err = work_dir() / ("stderr_" + tag + ".txt");
-  const std::string command = std::string("\"") + BIREG_FIT_EXECUTABLE + "\" " + arguments +
-                              " > \"" + out.string() + "\" 2> \"" + err.string() + "\"";
-  const int status = std::system(command.c_str());
-  Run run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = slurp(out);
-  run.err = slurp(err);
-  return run;
+  return bireg_test::run_executable(BIREG_FIT_EXECUTABLE, arguments);
 }
 
 // The numbers of the JSON value after "key": (a number or nested arrays),

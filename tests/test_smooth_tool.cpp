@@ -4,8 +4,6 @@
 // the write-error exit code. Lean on purpose: only the groups' headers, no
 // regression templates (the library's behaviour is tested in
 // test_local_regression.cpp).
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -19,32 +17,15 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "catch.hpp"
+#include "tool_runner.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Run {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-fs::path work_dir() {
-  const fs::path dir = fs::path(BIREG_TEST_WORK_DIR);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string data(const std::string& name) {
-  return std::string(BIREG_TEST_DATA_DIR) + "/" + name;
-}
+using bireg_test::data;
+using bireg_test::Run;
+using bireg_test::slurp;
+using bireg_test::work_dir;
 
 // A file in the work directory holding `text`; its path, quoted.
 std::string make_file(const std::string& name, const std::string& text) {
@@ -54,18 +35,7 @@ std::string make_file(const std::string& name, const std::string& text) {
 }
 
 Run run_tool(const std::string& arguments) {
-  // ctest runs test cases in parallel processes: one pair of files each.
-  const std::string tag = std::to_string(static_cast<long>(getpid()));
-  const fs::path out = work_dir() / ("stdout_" + tag + ".txt");
-  const fs::path err = work_dir() / ("stderr_" + tag + ".txt");
-  const std::string command = std::string("\"") + BIREG_SMOOTH_EXECUTABLE + "\" " + arguments +
-                              " > \"" + out.string() + "\" 2> \"" + err.string() + "\"";
-  const int status = std::system(command.c_str());
-  Run run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = slurp(out);
-  run.err = slurp(err);
-  return run;
+  return bireg_test::run_executable(BIREG_SMOOTH_EXECUTABLE, arguments);
 }
 
 std::vector<std::string> split(const std::string& text, char separator) {

@@ -184,17 +184,10 @@ class LocalGeodesicRegression {
 
     // Sorted once: the covariates ascending, the observations alongside.
     const std::size_t n = observations.size();
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return Scalar(covariates[a]) < Scalar(covariates[b]);
-    });
-    std::vector<Scalar> sorted_t(n);
-    std::vector<Element> sorted_f(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      sorted_t[i] = Scalar(covariates[order[i]]);
-      sorted_f[i] = observations[order[i]];
-    }
+    std::vector<std::size_t> order;
+    std::vector<Scalar> sorted_t;
+    std::vector<Element> sorted_f;
+    sort_by_covariate(observations, covariates, order, sorted_t, sorted_f);
     std::vector<std::size_t> query_order(queries.size());
     std::iota(query_order.begin(), query_order.end(), std::size_t(0));
     std::stable_sort(query_order.begin(), query_order.end(),
@@ -224,17 +217,10 @@ class LocalGeodesicRegression {
     problem = check(observations, covariates, {});
     if (!problem.empty()) return {};
     const std::size_t n = observations.size();
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return Scalar(covariates[a]) < Scalar(covariates[b]);
-    });
-    std::vector<Scalar> sorted_t(n);
-    std::vector<Element> sorted_f(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      sorted_t[i] = Scalar(covariates[order[i]]);
-      sorted_f[i] = observations[order[i]];
-    }
+    std::vector<std::size_t> order;
+    std::vector<Scalar> sorted_t;
+    std::vector<Element> sorted_f;
+    sort_by_covariate(observations, covariates, order, sorted_t, sorted_f);
     const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
     Window window;
     window.reserve(n);
@@ -255,6 +241,26 @@ class LocalGeodesicRegression {
   }
 
  private:
+  // The observations in ascending covariate order (stable: ties keep their
+  // input order), with the permutation that sorts them.
+  template <class Observations, class Covariates>
+  static void sort_by_covariate(const Observations& observations, const Covariates& covariates,
+                                std::vector<std::size_t>& order, std::vector<Scalar>& sorted_t,
+                                std::vector<Element>& sorted_f) {
+    const std::size_t n = observations.size();
+    order.resize(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return Scalar(covariates[a]) < Scalar(covariates[b]);
+    });
+    sorted_t.resize(n);
+    sorted_f.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      sorted_t[i] = Scalar(covariates[order[i]]);
+      sorted_f[i] = observations[order[i]];
+    }
+  }
+
   struct Window {
     std::vector<Element> observations;
     std::vector<Scalar> covariates;

@@ -1,0 +1,56 @@
+// Running a built command-line tool from a test: its exit code, stdout and
+// stderr, and the test's scratch and data directories (BIREG_TEST_WORK_DIR,
+// BIREG_TEST_DATA_DIR, set by tests/CMakeLists.txt). Shared by the tests of
+// bireg_fit and bireg_smooth.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace bireg_test {
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+inline std::filesystem::path work_dir() {
+  const std::filesystem::path dir = std::filesystem::path(BIREG_TEST_WORK_DIR);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline std::string data(const std::string& name) {
+  return std::string(BIREG_TEST_DATA_DIR) + "/" + name;
+}
+
+// Runs `executable arguments` through the shell, capturing both streams.
+inline Run run_executable(const std::string& executable, const std::string& arguments) {
+  // ctest runs test cases in parallel processes: one pair of files each.
+  const std::string tag = std::to_string(static_cast<long>(getpid()));
+  const std::filesystem::path out = work_dir() / ("stdout_" + tag + ".txt");
+  const std::filesystem::path err = work_dir() / ("stderr_" + tag + ".txt");
+  const std::string command = "\"" + executable + "\" " + arguments + " > \"" + out.string() +
+                              "\" 2> \"" + err.string() + "\"";
+  const int status = std::system(command.c_str());
+  Run run;
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.out = slurp(out);
+  run.err = slurp(err);
+  return run;
+}
+
+}  // namespace bireg_test
