@@ -32,6 +32,7 @@ tests (seconds to a minute); the whole table takes about 25-35 minutes with
 -j1. The first run also configures the scratch build (seconds).
 """
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -50,6 +51,7 @@ class Mutant:
     targets: List[str]  # test executables (ctest prefix "<target>: ")
     why: str  # the bug it stands for
     regex: str = ""  # optional ctest -R regex; default: every test of targets
+    # (ctest names are "<target>:<TEST_CASE name>"; no test matched is an error)
     tags: List[str] = field(default_factory=list)
 
 
@@ -148,13 +150,14 @@ MUTANTS = [
 
 
 def run(cmd, cwd, log, check=True):
+    """Runs cmd with its output appended to log; returns (exit code, output)."""
+    proc = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, errors="replace")
     with open(log, "a") as out:
-        out.write("\n$ " + " ".join(cmd) + "\n")
-        out.flush()
-        rc = subprocess.call(cmd, cwd=cwd, stdout=out, stderr=subprocess.STDOUT)
-    if check and rc != 0:
-        sys.exit(f"command failed ({rc}): {' '.join(cmd)}; see {log}")
-    return rc
+        out.write("\n$ " + " ".join(cmd) + "\n" + proc.stdout)
+    if check and proc.returncode != 0:
+        sys.exit(f"command failed ({proc.returncode}): {' '.join(cmd)}; see {log}")
+    return proc.returncode, proc.stdout
 
 
 def check_edits(root, mutants):
@@ -173,7 +176,8 @@ def check_edits(root, mutants):
 def main(argv):
     root = subprocess.check_output(["git", "rev-parse", "--show-toplevel"], text=True).strip()
     names = [a for a in argv if not a.startswith("--")]
-    mutants = [m for m in MUTANTS if not names or m.name in names]
+    by_name = {m.name: m for m in MUTANTS}
+    mutants = [by_name[n] for n in names if n in by_name] if names else list(MUTANTS)
     unknown = set(names) - {m.name for m in MUTANTS}
     if unknown:
         sys.exit(f"unknown mutants: {sorted(unknown)}")
@@ -192,6 +196,12 @@ def main(argv):
     src, build = os.path.join(scratch, "src"), os.path.join(scratch, "build")
     log = os.path.join(scratch, "mutation.log")
     os.makedirs(src, exist_ok=True)
+    # One run at a time per scratch directory: two would mutate each other's tree.
+    lock = open(os.path.join(scratch, "lock"), "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        sys.exit(f"another mutation check is running in {scratch}")
     open(log, "w").close()
     # The working tree's tracked files, as they are now (uncommitted edits
     # included); copy2 only where the content differs, so that an unchanged
@@ -222,14 +232,18 @@ def main(argv):
             with open(path, "w") as f:
                 f.write(original.replace(m.old, m.new, 1))
             built = run(["ninja", "-C", build, f"-j{jobs}"] + m.targets, scratch, log,
-                        check=False) == 0
+                        check=False)[0] == 0
             if not built:
                 outcome = "error (did not build)"
             else:
-                regex = m.regex or "^(" + "|".join(m.targets) + "): "
-                rc = run(["ctest", "--test-dir", build, "-R", regex, "--output-on-failure",
-                          "-j", jobs, "--timeout", "600"], scratch, log, check=False)
-                outcome = "killed" if rc != 0 else "SURVIVED"
+                regex = m.regex or "^(" + "|".join(m.targets) + "):"
+                rc, output = run(["ctest", "--test-dir", build, "-R", regex,
+                                  "--output-on-failure", "-j", jobs, "--timeout", "600"],
+                                 scratch, log, check=False)
+                if "tests passed" not in output:  # none matched, or ctest itself failed
+                    outcome = "error (no tests ran)"
+                else:
+                    outcome = "killed" if rc != 0 else "SURVIVED"
         finally:
             with open(path, "w") as f:
                 f.write(original)
