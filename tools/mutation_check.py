@@ -28,8 +28,10 @@ table cannot rot silently when the code changes.
 
 Time: each mutant recompiles its 1-2 test translation units (Eigen-heavy:
 about 1-1.5 min each with -j1 on the 2-core CI-sized machine) and runs their
-tests (seconds to a minute); the whole table takes about 25-35 minutes with
--j1. The first run also configures the scratch build (seconds).
+tests (seconds to a minute); the whole table takes about 30 minutes with
+-j1 on an idle machine, and took 35 minutes for 15 mutants on 2026-11-23
+with other builds sharing the 2 cores. The first run also configures the
+scratch build (seconds).
 """
 
 import fcntl
