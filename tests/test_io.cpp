@@ -136,6 +136,15 @@ TEST_CASE("line reader: ends of line, bounded length, NUL bytes, 64-bit counts",
           std::uint64_t>);
 }
 
+// A file whose last line has no '\n' (common from editors and scripts):
+// that line is counted like the others, both in an error and in the source
+// line recorded for each observation.
+TEST_CASE("the last line without a newline has its own line number", "[io]") {
+  REQUIRE(read_error<SO3>("0 1 0 0 0 1 0 0 0 1\n1 1 0 0 0 1 0 0 0 x").line == 2);
+  const auto ok = read_ok<SO3>("# header\n0 1 0 0 0 1 0 0 0 1\n1 1 0 0 0 1 0 0 0 1");
+  REQUIRE(ok.lines == std::vector<std::uint64_t>{2, 3});
+}
+
 TEST_CASE("line reader: /dev/zero fails at once on line 1 with bounded memory", "[io]") {
   std::FILE* zero = std::fopen("/dev/zero", "rb");
   if (!zero) {

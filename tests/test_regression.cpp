@@ -676,6 +676,48 @@ struct CoverSE2 {
 };
 }  // namespace
 
+// beyond_domain is documented as "the largest residual angle exceeds
+// 3 pi / 4" (regression/diagnostics.hpp). An exact geodesic of 41 rotations
+// turning by 1 rad, with the middle one turned away from it by `offset`
+// about a perpendicular axis: a least-squares line moves towards an outlier
+// by its leverage, 1/41 in the middle, so the outlier's residual is about
+// offset (1 - 1/41) and every other residual is far smaller. Offsets
+// 0.70 pi and 0.85 pi put that residual at 0.683 pi and 0.829 pi (measured;
+// the bands below only check it landed there), so a threshold moved out of
+// (0.683 pi, 0.829 pi), to 0.95 pi say, or pi/2, fails one of the flags.
+TEST_CASE("beyond_domain flags a residual angle beyond 3 pi / 4, not below",
+          "[regression][diagnostics]") {
+  using G = bireg::SO3<double>;
+  const double pi = 3.14159265358979323846;
+  const auto fit_with_outlier = [](double offset) {
+    std::vector<G::Element> f;
+    std::vector<double> t;
+    for (int i = 0; i <= 40; ++i) {
+      const double s = i / 40.0;
+      G::Element g = G::exp(G::Tangent(0, 0, s));
+      if (i == 20) g = G::compose(g, G::exp(G::Tangent(offset, 0, 0)));
+      f.push_back(g);
+      t.push_back(s);
+    }
+    return bireg::GeodesicRegression<G>().fit(f, t);
+  };
+  const auto inside = fit_with_outlier(0.70 * pi);
+  REQUIRE(inside.ok());
+  CAPTURE(inside.diagnostics.largest_residual_angle / pi);
+  REQUIRE(inside.diagnostics.largest_residual_observation == 20);
+  REQUIRE(inside.diagnostics.largest_residual_angle > 0.60 * pi);
+  REQUIRE(inside.diagnostics.largest_residual_angle < 0.72 * pi);
+  REQUIRE_FALSE(inside.diagnostics.beyond_domain);
+
+  const auto beyond = fit_with_outlier(0.85 * pi);
+  REQUIRE(beyond.ok());
+  CAPTURE(beyond.diagnostics.largest_residual_angle / pi);
+  REQUIRE(beyond.diagnostics.largest_residual_observation == 20);
+  REQUIRE(beyond.diagnostics.largest_residual_angle > 0.78 * pi);
+  REQUIRE(beyond.diagnostics.largest_residual_angle < 0.90 * pi);
+  REQUIRE(beyond.diagnostics.beyond_domain);
+}
+
 TEST_CASE("non-convergence is reported in the status, with finite endpoints",
           "[regression][errors]") {
   SECTION("iteration limit") {

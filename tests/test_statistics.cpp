@@ -4,6 +4,7 @@
 // differences and the fit's series K, the bi-invariant mean, the quantiles,
 // and every refusal. (Coverage and calibration by simulation:
 // test_statistics_simulation.cpp.)
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -208,6 +209,26 @@ TEST_CASE("the covariance does not depend on a common scale of the weights",
   const auto c = bireg::covariance(fit, data.t, w);
   CHECK(c.degrees_of_freedom < 28);
   CHECK(c.degrees_of_freedom > 10);
+  // The value itself, from the documented formula evaluated here in long
+  // double on the raw covariates z = (1, t) (tr(H^{-1} H_2) is unchanged by
+  // the library's affine map of t to [0, 1]: H -> A H A^T, H_2 -> A H_2 A^T),
+  // with the weights divided by the largest as the library does (nu scales
+  // like w). A 2x2 inverse of a well-conditioned H and sums of 30 positive
+  // terms: rounding ~1e-15 relative; 1e-12 leaves room for the library's
+  // double. The weight-blind W - 2 is 0.69 (5%) away here, checked last so
+  // that the comparison is known to discriminate.
+  long double w_sum = 0, w_max = 0;
+  Eigen::Matrix<long double, 2, 2> h = Eigen::Matrix<long double, 2, 2>::Zero(), h2 = h;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const Eigen::Matrix<long double, 2, 1> z(1.0L, static_cast<long double>(data.t[i]));
+    w_sum += w[i];
+    w_max = std::max<long double>(w_max, w[i]);
+    h += w[i] * z * z.transpose();
+    h2 += static_cast<long double>(w[i]) * w[i] * z * z.transpose();
+  }
+  const long double nu = (w_sum - (h.inverse() * h2).trace()) / w_max;
+  CHECK(c.degrees_of_freedom == Approx(static_cast<double>(nu)).epsilon(1e-12));
+  CHECK(std::abs(static_cast<double>(nu) - (w_sum / w_max - 2)) > 0.5);
 }
 
 TEST_CASE("on R^n the permutation p-value equals the OLS F test's with the same permutations",
