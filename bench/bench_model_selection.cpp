@@ -1,7 +1,10 @@
 // Cost of bireg::select_motion_model against one SE(3) fit of the same data:
 // 60 poses of a screw motion with 0.01 noise. The ratio of the two timings
 // is the selection's cost in SE(3) fits (5 candidates x (1 + 5 folds) fits,
-// most of them on the cheaper SO(3) and Rn<3>).
+// most of them on the cheaper SO(3) and Rn<3>). The same scene as
+// similarities (scale 1.3, log-scale drifting by 0.4) times the Sim(3)
+// selection: 6 candidates x (1 + 5 folds), the sixth a Sim(3) fit.
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -9,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/model_selection.hpp"
 
@@ -36,6 +40,13 @@ Scene screw_scene() {
   return scene;
 }
 
+Scene drifting_scene() {
+  Scene scene = screw_scene();
+  for (std::size_t i = 0; i < scene.poses.size(); ++i)
+    scene.poses[i].topLeftCorner<3, 3>() *= 1.3 * std::exp(0.4 * scene.times[i]);
+  return scene;
+}
+
 void se3_fit(benchmark::State& state) {
   const Scene scene = screw_scene();
   const bireg::GeodesicRegression<bireg::SE3d> regression;
@@ -49,9 +60,26 @@ void model_selection(benchmark::State& state) {
     benchmark::DoNotOptimize(bireg::select_motion_model(scene.poses, scene.times));
 }
 
+void sim3_fit(benchmark::State& state) {
+  const Scene scene = drifting_scene();
+  const bireg::GeodesicRegression<bireg::Sim3d> regression;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(regression.fit(scene.poses, scene.times));
+}
+
+void sim3_model_selection(benchmark::State& state) {
+  const Scene scene = drifting_scene();
+  bireg::ModelSelectionOptions options;
+  options.group = bireg::PoseGroup::sim3;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(bireg::select_motion_model(scene.poses, scene.times, options));
+}
+
 }  // namespace
 
 BENCHMARK(se3_fit)->Unit(benchmark::kMicrosecond);
 BENCHMARK(model_selection)->Unit(benchmark::kMicrosecond);
+BENCHMARK(sim3_fit)->Unit(benchmark::kMicrosecond);
+BENCHMARK(sim3_model_selection)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();

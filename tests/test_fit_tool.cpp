@@ -212,7 +212,10 @@ TEST_CASE("bireg_fit reports every input error on one line with exit code 2", "[
        "sl3_not_in_group.csv:4: matrix is not an element of SL3"},
       {"--group GLp3", "glp3_not_in_group.csv",
        "glp3_not_in_group.csv:2: matrix is not an element of GLp"},
-      {"--group Sim3", "so3_small.csv", "so3_small.csv:3: expected 17 numbers, found 10"},
+      {"--group Sim3", "so3_small.csv", "so3_small.csv:3: no format fits this line (10 numbers"},
+      {"--group Sim3 --format tum --output-trajectory never.tum", "se3_small.tum",
+       "the tum format holds SE3 or SO3 poses, not Sim3 (the input's format; use --output-format "
+       "matrix)"},
       {"--group SL3 --format tum", "se3_small.tum",
        "the tum format holds SE3 or SO3 poses, not SL3"},
       {"--group SL3", "sl3_no_logarithm.csv",
@@ -1102,4 +1105,75 @@ TEST_CASE("bireg_fit --group auto recommends the generating model and writes its
   const Run refused = run_tool("--group auto --loss tukey " + quoted(file));
   REQUIRE(refused.exit_code == 2);
   REQUIRE(refused.err.find("--group auto takes") != std::string::npos);
+}
+
+// Similarities (matrix format, Sim3 elements): --group auto reads them in
+// the same pass, compares the six Sim(3) candidates, and recommends the one
+// that generated the scene: the screw with a log-scale drift of 0.4 (40
+// noise levels), or a pure rotation at the constant scale 1.3. As in
+// test_model_selection.cpp, noise 0.01 per Sim(3) tangent coordinate.
+namespace {
+std::string sim3_scene(bool scale_drifts, unsigned seed) {
+  using S = bireg::Sim3<double>;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  S::Tangent xi;
+  xi << 0.5, 0.2, -0.3, 0.4, -0.6, 1.0, 0.4;
+  if (!scale_drifts) xi << 0, 0, 0, 0.4, -0.6, 1.0, 0;
+  S::Tangent start;
+  start << 1.0, -2.0, 0.5, 0.3, 0.1, -0.2, std::log(1.3);
+  std::string text;
+  for (int i = 0; i < 60; ++i) {
+    const double u = i / 59.0;
+    S::Tangent e;
+    for (int j = 0; j < 7; ++j)
+      e[j] = noise(rng);
+    const Eigen::Matrix4d f = S::compose(S::exp(start), S::compose(S::exp(u * xi), S::exp(e)));
+    text += g17(u);
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c)
+        text += ", " + g17(f(r, c));
+    text += "\n";
+  }
+  return text;
+}
+}  // namespace
+
+TEST_CASE("bireg_fit --group auto on similarities compares the Sim(3) candidates",
+          "[tool][model_selection]") {
+  for (const bool drifts : {true, false}) {
+    CAPTURE(drifts);
+    const std::string file = scratch(drifts ? "auto_sim3_drift.csv" : "auto_sim3_rotation.csv");
+    write_text(file, sim3_scene(drifts, 11));
+    const std::string out = scratch(drifts ? "auto_sim3_drift_fit.csv" : "auto_sim3_rot_fit.csv");
+    const Run run =
+        run_tool("--group auto --output-trajectory " + quoted(out) + " " + quoted(file));
+    CAPTURE(run.out, run.err);
+    REQUIRE(run.exit_code == 0);
+    REQUIRE(json_string(run.out, "pose_group") == "Sim3");
+    REQUIRE(json_string(run.out, "recommended") == (drifts ? "similarity" : "rotation_only"));
+    std::size_t rows = 0;
+    for (std::size_t at = run.out.find("{\"model\": "); at != std::string::npos;
+         at = run.out.find("{\"model\": ", at + 1))
+      ++rows;
+    REQUIRE(rows == 6);
+    REQUIRE_FALSE(json_has_non_finite(run.out));
+    // The written prediction's scale at both ends: 1.3 and 1.3 e^0.4 (or
+    // 1.3 throughout). The fitted log-scale at an end of a line through 60
+    // points with noise 0.01 has sd 0.01 * sqrt(4/60) = 0.0026; 5 sd allowed.
+    const auto fitted = read_file<bireg::Sim3<double>>(out, bireg::io::Format::matrix);
+    REQUIRE(fitted.observations.size() == 60);
+    const auto log_scale = [](const Eigen::Matrix4d& g) {
+      return std::log(g.topLeftCorner<3, 3>().determinant()) / 3;
+    };
+    REQUIRE(std::abs(log_scale(fitted.observations.front()) - std::log(1.3)) <= 0.013);
+    REQUIRE(std::abs(log_scale(fitted.observations.back()) -
+                     (std::log(1.3) + (drifts ? 0.4 : 0.0))) <= 0.013);
+  }
+  // A similarity has no TUM spelling: refused before any fitting.
+  const std::string file = scratch("auto_sim3_drift.csv");
+  const Run refused = run_tool("--group auto --output-format tum --output-trajectory " +
+                               quoted(scratch("never.tum")) + " " + quoted(file));
+  REQUIRE(refused.exit_code == 2);
+  REQUIRE(refused.err.find("not Sim3") != std::string::npos);
 }

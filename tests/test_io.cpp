@@ -16,6 +16,7 @@
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/formats.hpp"
 #include "bireg/io/line_reader.hpp"
@@ -453,6 +454,35 @@ TEST_CASE("write errors are reported", "[io]") {
   std::fclose(full);
   REQUIRE(error);
   REQUIRE(error->find("write error") == 0);
+}
+
+// Sim(3) reads the pose formats (a rigid pose is a similarity of scale 1;
+// bireg_fit --group auto relies on it) and detects them by content like
+// SE(3); writing a similarity in a pose format is refused, never a silent
+// drop of the scale.
+TEST_CASE("Sim3 reads the pose formats as scale 1 and refuses to write them", "[io]") {
+  using Sim3 = bireg::Sim3<double>;
+  const auto poses = random_poses(4, 2);
+  const auto times = timestamps_of({"0", "1", "2", "3"}, bireg::io::TimeUnit::seconds);
+  for (Format format : {Format::tum, Format::kitti}) {
+    CAPTURE(bireg::io::to_string(format));
+    const std::string text = bireg::io::format_trajectory<SE3>(format, Format::tum, times, poses);
+    const auto rigid = read_ok<SE3>(text);
+    const auto similar = read_ok<Sim3>(text);
+    REQUIRE(similar.format == format);
+    REQUIRE(similar.observations.size() == rigid.observations.size());
+    for (std::size_t i = 0; i < rigid.observations.size(); ++i)
+      REQUIRE(similar.observations[i] == rigid.observations[i]);
+  }
+  std::FILE* sink = std::fopen("/dev/null", "wb");
+  REQUIRE(sink);
+  std::vector<Sim3::Element> scaled(poses.begin(), poses.end());
+  scaled[1].topLeftCorner<3, 3>() *= 2.0;
+  const auto error =
+      bireg::io::write_trajectory<Sim3>(sink, Format::tum, Format::tum, times, scaled);
+  std::fclose(sink);
+  REQUIRE(error);
+  REQUIRE(error->find("not Sim3") != std::string::npos);
 }
 
 TEST_CASE("JSON numbers are never nan or inf", "[io]") {

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/model_selection.hpp"
 #include "catch.hpp"
@@ -36,12 +37,18 @@ Pose pose_of(const Eigen::Matrix3d& r, const Eigen::Vector3d& p) {
 
 // A scene from `model` over t in [0, 1]: rotation by 0.6 rad and translation
 // by 0.6 m over the interval where the model moves, 60 noise sd; noise
-// f_i = P(t_i) exp(e_i), e_i ~ N(0, kNoise^2 I_6).
-Scene simulate(MotionModel model, std::mt19937& rng) {
+// f_i = P(t_i) exp(e_i), e_i ~ N(0, kNoise^2 I_d). Similarities (group
+// sim3): the rigid models' poses carry the constant scale 1.3, the
+// similarity model is the screw with log-scale growing by 0.4 (40 noise sd),
+// and the noise is Sim(3)'s, log-scale included (d = 7).
+Scene simulate(MotionModel model, std::mt19937& rng,
+               bireg::PoseGroup group = bireg::PoseGroup::se3) {
   std::normal_distribution<double> normal(0.0, 1.0);
   const Eigen::Vector3d omega(0.2, -0.3, 0.5), velocity(0.5, 0.2, -0.3);
   const Eigen::Matrix3d r0 = bireg::SO3d::exp(Eigen::Vector3d(0.3, 0.1, -0.2));
   const Eigen::Vector3d p0(1.0, -2.0, 0.5);
+  const bool similarities = group == bireg::PoseGroup::sim3;
+  const double scale = similarities ? 1.3 : 1.0;
   Scene scene;
   for (int i = 0; i < kObservations; ++i) {
     const double t = static_cast<double>(i) / (kObservations - 1);
@@ -64,11 +71,25 @@ Scene simulate(MotionModel model, std::mt19937& rng) {
         truth = bireg::SE3d::compose(pose_of(r0, p0), bireg::SE3d::exp(t * xi));
         break;
       }
+      case MotionModel::similarity: {
+        bireg::Sim3d::Tangent xi;
+        xi << velocity, 2.0 * omega, 0.4;  // the screw, and the scale grows by e^0.4
+        truth = bireg::Sim3d::compose(pose_of(r0, p0), bireg::Sim3d::exp(t * xi));
+        break;
+      }
     }
-    Twist e;
-    for (int j = 0; j < 6; ++j)
-      e[j] = kNoise * normal(rng);
-    scene.poses.push_back(bireg::SE3d::compose(truth, bireg::SE3d::exp(e)));
+    truth.topLeftCorner<3, 3>() *= scale;
+    if (similarities) {
+      bireg::Sim3d::Tangent e;
+      for (int j = 0; j < 7; ++j)
+        e[j] = kNoise * normal(rng);
+      scene.poses.push_back(bireg::Sim3d::compose(truth, bireg::Sim3d::exp(e)));
+    } else {
+      Twist e;
+      for (int j = 0; j < 6; ++j)
+        e[j] = kNoise * normal(rng);
+      scene.poses.push_back(bireg::SE3d::compose(truth, bireg::SE3d::exp(e)));
+    }
     scene.times.push_back(t);
   }
   return scene;
@@ -87,26 +108,39 @@ const std::pair<MotionModel, MotionModel> kNested[] = {
     {MotionModel::translation_only, MotionModel::rotation_and_line},
     {MotionModel::static_pose, MotionModel::screw}};
 
-}  // namespace
+// Nested pairs of the Sim(3) lattice: the rigid ones with a constant scale,
+// and the screw with constant scale in the similarity.
+const std::pair<MotionModel, MotionModel> kSimilarityNested[] = {
+    {MotionModel::static_pose, MotionModel::rotation_only},
+    {MotionModel::static_pose, MotionModel::translation_only},
+    {MotionModel::rotation_only, MotionModel::rotation_and_line},
+    {MotionModel::translation_only, MotionModel::rotation_and_line},
+    {MotionModel::static_pose, MotionModel::screw},
+    {MotionModel::screw, MotionModel::similarity},
+    {MotionModel::static_pose, MotionModel::similarity}};
 
 // 200 replicates per model. If the true recovery rate were 0.93, P(at least
 // 190 of 200) = 0.08 (binomial); at a true rate of 0.99 the test fails with
 // probability 0.0004 (P(at most 189)). The seeds are fixed, so the outcome is
 // reproducible; the counts and the nesting frequencies are printed.
-TEST_CASE("the generating model is recovered in at least 95% of replicates") {
+template <class Models, class Nested>
+void check_recovery(const Models& models, const Nested& nested, bireg::PoseGroup group) {
   constexpr int kReplicates = 200;
-  for (MotionModel model : bireg::kMotionModels) {
-    std::mt19937 rng(1234u + static_cast<unsigned>(model));
+  bireg::ModelSelectionOptions options;
+  options.group = group;
+  for (MotionModel model : models) {
+    std::mt19937 rng(1234u + static_cast<unsigned>(model) +
+                     (group == bireg::PoseGroup::sim3 ? 100u : 0u));
     int recovered = 0, ambiguous = 0;
     int nested_inversions = 0, nested_pairs = 0;
     double worst_inversion = 0;
     for (int rep = 0; rep < kReplicates; ++rep) {
-      const Scene scene = simulate(model, rng);
-      const auto s = bireg::select_motion_model(scene.poses, scene.times);
+      const Scene scene = simulate(model, rng, group);
+      const auto s = bireg::select_motion_model(scene.poses, scene.times, options);
       REQUIRE(s.recommended.has_value());
       if (*s.recommended == model) ++recovered;
       if (s.ambiguous) ++ambiguous;
-      for (const auto& [inner, outer] : kNested) {
+      for (const auto& [inner, outer] : nested) {
         const double inner_log_det = report_of(s, inner).log_det;
         const double outer_log_det = report_of(s, outer).log_det;
         ++nested_pairs;
@@ -118,18 +152,28 @@ TEST_CASE("the generating model is recovered in at least 95% of replicates") {
       // Never prefer a model nested in the generating one by more than
       // the margin: the generating model's criterion is within the margin
       // of the recommended one whenever the recommended one is nested in it.
-      for (const auto& [inner, outer] : kNested) {
+      for (const auto& [inner, outer] : nested) {
         if (outer == model && *s.recommended == inner)
           CHECK(report_of(s, outer).criterion <=
                 report_of(s, inner).criterion + bireg::kSelectionMargin);
       }
     }
     std::printf(
-        "%-18s recovered %3d/%d, ambiguous %3d, nested log-det inversions %d/%d (worst %.3g)\n",
-        bireg::to_string(model), recovered, kReplicates, ambiguous, nested_inversions, nested_pairs,
-        worst_inversion);
+        "%s %-18s recovered %3d/%d, ambiguous %3d, nested log-det inversions %d/%d (worst %.3g)\n",
+        group == bireg::PoseGroup::sim3 ? "Sim3" : "SE3 ", bireg::to_string(model), recovered,
+        kReplicates, ambiguous, nested_inversions, nested_pairs, worst_inversion);
     CHECK(recovered >= 190);
   }
+}
+
+}  // namespace
+
+TEST_CASE("the generating model is recovered in at least 95% of replicates") {
+  check_recovery(bireg::kMotionModels, kNested, bireg::PoseGroup::se3);
+}
+
+TEST_CASE("on similarities the generating model, scale drift included, is recovered") {
+  check_recovery(bireg::kSimilarityMotionModels, kSimilarityNested, bireg::PoseGroup::sim3);
 }
 
 TEST_CASE("criteria and verdict are invariant under left translation and shuffling") {
@@ -206,4 +250,62 @@ TEST_CASE("degenerate input: too few observations and noise-free planar data") {
   }
   const auto empty = bireg::select_motion_model(std::vector<Pose>{}, std::vector<double>{});
   CHECK_FALSE(empty.recommended.has_value());
+}
+
+// Sim(3) data: left translation by a similarity leaves every criterion and
+// CV error unchanged (all six estimators are left equivariant; the SE(3)
+// fit of the rigid parts commutes with the scaling of translations); right
+// translation by h maps the static and similarity residuals by
+// Ad_{h^-1}, det = s_h^-3, so both criteria shift by -3 N log s_h.
+// Tolerance 1e-9 relative as for SE(3) above.
+TEST_CASE(
+    "on similarities the criteria are left invariant and shift by -3 N log s under right "
+    "translation") {
+  std::mt19937 rng(41);
+  bireg::ModelSelectionOptions options;
+  options.group = bireg::PoseGroup::sim3;
+  bireg::Sim3d::Tangent h_log;
+  h_log << 3.0, -1.0, 2.0, 0.7, -0.4, 1.1, 0.53;
+  const Pose h = bireg::Sim3d::exp(h_log);
+  for (MotionModel model : bireg::kSimilarityMotionModels) {
+    const Scene scene = simulate(model, rng, bireg::PoseGroup::sim3);
+    Scene left = scene, right = scene;
+    for (auto& f : left.poses)
+      f = bireg::Sim3d::compose(h, f);
+    for (auto& f : right.poses)
+      f = bireg::Sim3d::compose(f, h);
+    const auto base = bireg::select_motion_model(scene.poses, scene.times, options);
+    const auto l = bireg::select_motion_model(left.poses, left.times, options);
+    const auto r = bireg::select_motion_model(right.poses, right.times, options);
+    REQUIRE(base.candidates.size() == 6);
+    CHECK(l.recommended == base.recommended);
+    for (std::size_t c = 0; c < base.candidates.size(); ++c) {
+      const double scale = std::max(1.0, std::abs(base.candidates[c].criterion));
+      CHECK(std::abs(l.candidates[c].criterion - base.candidates[c].criterion) <= 1e-9 * scale);
+      REQUIRE(l.candidates[c].cv_error.has_value());
+      CHECK(std::abs(*l.candidates[c].cv_error - *base.candidates[c].cv_error) <=
+            1e-9 * *base.candidates[c].cv_error);
+    }
+    const double shift = -3.0 * kObservations * h_log[6];
+    for (MotionModel m : {MotionModel::static_pose, MotionModel::similarity}) {
+      const double scale = std::max(1.0, std::abs(report_of(base, m).criterion));
+      CHECK(std::abs(report_of(r, m).criterion - (report_of(base, m).criterion + shift)) <=
+            1e-9 * scale);
+    }
+    // The returned prediction is the recommended model's own fit.
+    REQUIRE(base.prediction.has_value());
+    const auto refit = bireg::fit_motion_model(*base.recommended, scene.poses, scene.times,
+                                               bireg::PoseGroup::sim3);
+    REQUIRE(refit.has_value());
+    CHECK(((*base.prediction)(0.37) - (*refit)(0.37)).norm() == 0.0);
+  }
+}
+
+TEST_CASE("SE(3) data have no similarity candidate") {
+  std::mt19937 rng(5);
+  const Scene scene = simulate(MotionModel::screw, rng);
+  const auto s = bireg::select_motion_model(scene.poses, scene.times);
+  CHECK(s.candidates.size() == 5);
+  CHECK_FALSE(
+      bireg::fit_motion_model(MotionModel::similarity, scene.poses, scene.times).has_value());
 }

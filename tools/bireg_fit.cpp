@@ -11,10 +11,11 @@
 //
 // The formats, their detection when --format is omitted, --times and
 // --project are described in include/bireg/io/formats.hpp and README.md.
-// Sim3 (4x4 [s R t; 0 1]), SL3 and GLp3 (3x3) read the matrix format only.
-// --group auto reads SE(3) poses and chooses the motion model they need
-// (tools/fit_auto.hpp); it takes the input options and --output-trajectory
-// / --output-format only.
+// SL3 and GLp3 (3x3) read the matrix format only; Sim3 (4x4 [s R t; 0 1])
+// also reads the pose formats as scale 1 and writes the matrix format only.
+// --group auto reads SE(3) or Sim(3) poses and chooses the motion model they
+// need (tools/fit_auto.hpp); it takes the input options and
+// --output-trajectory / --output-format only.
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
 //
@@ -303,13 +304,19 @@ int run(const Command& command) {
   using Regression = bireg::GeodesicRegression<G>;
   namespace io = bireg::io;
   const std::string name = bireg_cli::display_name(command.input.path);
-  if (command.output_format && !io::supports<G>(*command.output_format)) {
-    return fail(std::string("the ") + io::to_string(*command.output_format) +
-                " format holds SE3 or SO3 poses, not " + G::name);
+  if (command.output_format) {
+    if (auto problem =
+            bireg_cli::output_format_problem<G>(command.output_format, io::Format::matrix))
+      return fail(*problem);
   }
 
   io::Trajectory<G> trajectory;
   if (auto error = bireg_cli::read_input<G>(command.input, trajectory)) return fail(*error);
+  if (!command.output_trajectory.empty()) {
+    if (auto problem =
+            bireg_cli::output_format_problem<G>(command.output_format, trajectory.format))
+      return fail(name + ": " + *problem);
+  }
 
   typename Regression::Options options;
   options.method = command.method;

@@ -237,12 +237,18 @@ template <class G>
 int run(const Command& command) {
   namespace io = bireg::io;
   const std::string name = bireg_cli::display_name(command.input.path);
-  if (command.output_format && !io::supports<G>(*command.output_format)) {
-    return fail(std::string("the ") + io::to_string(*command.output_format) +
-                " format holds SE3 or SO3 poses, not " + G::name);
+  if (command.output_format) {
+    if (auto problem =
+            bireg_cli::output_format_problem<G>(command.output_format, io::Format::matrix))
+      return fail(*problem);
   }
   io::Trajectory<G> trajectory;
   if (auto error = bireg_cli::read_input<G>(command.input, trajectory)) return fail(*error);
+  if (!command.output.empty()) {
+    if (auto problem =
+            bireg_cli::output_format_problem<G>(command.output_format, trajectory.format))
+      return fail(name + ": " + *problem);
+  }
   const io::TimeUnit unit = io::time_unit(trajectory.format);
   // The same refusals, in the same words, as bireg_fit's.
   const std::size_t n = trajectory.observations.size();

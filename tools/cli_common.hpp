@@ -124,6 +124,20 @@ std::optional<std::string> read_input(const InputOptions& input,
   return std::nullopt;
 }
 
+// Why the output trajectory of G cannot be written in `requested` (or, if
+// none, in the input's `input` format): a similarity read from a pose file
+// (Sim3 reads them as scale 1) has no TUM, EuRoC or KITTI spelling. Checked
+// before fitting so that the tool fails before the work, not after it.
+template <class G>
+std::optional<std::string> output_format_problem(std::optional<bireg::io::Format> requested,
+                                                 bireg::io::Format input) {
+  const bireg::io::Format format = requested.value_or(input);
+  if (bireg::io::supports<G>(format)) return std::nullopt;
+  return std::string("the ") + bireg::io::to_string(format) +
+         " format holds SE3 or SO3 poses, not " + G::name +
+         (requested ? "" : " (the input's format; use --output-format matrix)");
+}
+
 // Writes `poses` at `timestamps` to `path` ("-": standard output) in
 // `format`, timestamps rendered as the `source` format wrote them. Returns
 // "path: reason" when the file cannot be written.

@@ -14,7 +14,15 @@
 //     same number of observations with the same timestamps;
 //   * fit() on parsed input never crashes, never returns NaN or infinity
 //     in its endpoints or diagnostics, and reports invalid input only with
-//     a message.
+//     a message;
+//   * for SO3 and SE3 (the groups bireg_fit computes statistics for) and
+//     Sim3: the bi-invariant mean is finite when it succeeds; a defined
+//     covariance (both flavours) is finite, symmetric and positive
+//     semi-definite with positive degrees of freedom, an undefined one has
+//     a message; the trend test (9 permutations) gives a p-value in (0, 1]
+//     and a finite, non-negative statistic; motion-model selection (SE3 and
+//     Sim3) gives finite criteria and recommends a model whenever one was
+//     fitted.
 //
 // Build and run (clang):
 //   cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DBIREG_BUILD_FUZZERS=ON
@@ -26,7 +34,11 @@
 #include <cstdlib>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se2.hpp"
@@ -38,6 +50,10 @@
 #include "bireg/io/line_reader.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/mean.hpp"
+#include "bireg/statistics/model_selection.hpp"
+#include "bireg/statistics/trend_test.hpp"
 
 namespace {
 
@@ -60,6 +76,67 @@ void require_message(const bireg::io::ParseError& error, const std::string& text
   require(error.line <= count_lines(text));
 }
 
+// A defined covariance is finite, symmetric and positive semi-definite
+// (eigenvalues >= -1e-9 of the largest: rounding of a PSD sandwich).
+template <class G>
+void check_covariance(const bireg::FitCovariance<G>& c) {
+  if (!c.defined()) {
+    require(!c.message.empty());
+    return;
+  }
+  const auto& m = c.endpoints;
+  require(m.allFinite() && c.residual.allFinite());
+  const double scale = m.cwiseAbs().maxCoeff();
+  require((m - m.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale + 1e-300);
+  using Matrix = std::decay_t<decltype(m)>;
+  const Eigen::SelfAdjointEigenSolver<Matrix> eigen(m, Eigen::EigenvaluesOnly);
+  require(eigen.eigenvalues().minCoeff() >= -1e-9 * scale);
+  require(std::isfinite(c.degrees_of_freedom) && c.degrees_of_freedom > 0);
+  for (double nu :
+       {c.effective.endpoints, c.effective.start, c.effective.end, c.effective.velocity})
+    require(std::isfinite(nu) && nu > 0);
+}
+
+template <class G>
+void exercise_statistics(const bireg::io::Trajectory<G>& trajectory,
+                         const bireg::GeodesicRegression<G>& regression,
+                         const bireg::RegressionResult<G>& fit) {
+  const auto m = bireg::mean<G>(trajectory.observations);
+  if (m.ok()) require(m.mean->allFinite());
+  if (!fit.ok()) return;
+  for (auto flavour : {bireg::CovarianceFlavour::homoscedastic, bireg::CovarianceFlavour::robust})
+    check_covariance(bireg::covariance(fit, trajectory.covariates, {}, flavour));
+  bireg::TrendTestOptions options;
+  options.permutations = 9;
+  options.seed = 1;
+  const auto test =
+      bireg::trend_test(regression, trajectory.observations, trajectory.covariates, {}, options);
+  if (test.ok()) {
+    require(test.p_value > 0 && test.p_value <= 1);
+    require(std::isfinite(test.statistic) && test.statistic >= 0);
+  } else {
+    require(!test.message.empty());
+  }
+  if constexpr (std::is_same_v<G, bireg::SE3<double>> || std::is_same_v<G, bireg::Sim3<double>>) {
+    bireg::ModelSelectionOptions selection_options;
+    selection_options.folds = 2;
+    if (std::is_same_v<G, bireg::Sim3<double>>) selection_options.group = bireg::PoseGroup::sim3;
+    const auto selection = bireg::select_motion_model(trajectory.observations,
+                                                      trajectory.covariates, selection_options);
+    bool any_fitted = false;
+    for (const auto& c : selection.candidates) {
+      if (!c.fitted) continue;
+      any_fitted = true;
+      require(std::isfinite(c.criterion) && std::isfinite(c.log_det));
+      require(std::isfinite(c.rotation_rms_degrees) && std::isfinite(c.translation_rms) &&
+              std::isfinite(c.log_scale_rms));
+      if (c.cv_error) require(std::isfinite(*c.cv_error));
+    }
+    require(any_fitted == selection.recommended.has_value());
+    require(selection.recommended.has_value() == selection.prediction.has_value());
+  }
+}
+
 template <class G>
 void exercise(const std::string& text, const bireg::io::ReadOptions& read_options,
               bireg::Solver solver) {
@@ -79,17 +156,21 @@ void exercise(const std::string& text, const bireg::io::ReadOptions& read_option
     require(std::isfinite(c) && c >= 0);
   require(std::isfinite(trajectory.projection_correction));
 
-  // Written back in the format read, the text reads again.
+  // Written back in the format read (the matrix format for a similarity
+  // read from a pose format), the text reads again.
+  const bireg::io::Format written_format =
+      bireg::io::supports<G>(trajectory.format) ? trajectory.format : bireg::io::Format::matrix;
   const std::string written = bireg::io::format_trajectory<G>(
-      trajectory.format, trajectory.format, trajectory.timestamps, trajectory.observations);
+      written_format, trajectory.format, trajectory.timestamps, trajectory.observations);
   bireg::io::ReadOptions again;
-  again.format = trajectory.format;
+  again.format = written_format;
   if (trajectory.format == bireg::io::Format::kitti) again.times = &trajectory.timestamps;
   bireg::io::MemorySource written_source(written);
   bireg::io::Trajectory<G> reread;
   require(!bireg::io::read_trajectory<G>(written_source, again, reread));
   require(reread.observations.size() == trajectory.observations.size());
-  for (std::size_t i = 0; i < reread.timestamps.size(); ++i) {
+  for (std::size_t i = 0; i < reread.timestamps.size() && written_format == trajectory.format;
+       ++i) {
     require(reread.timestamps[i].text == trajectory.timestamps[i].text);
     require(reread.covariates[i] == trajectory.covariates[i]);
   }
@@ -111,6 +192,10 @@ void exercise(const std::string& text, const bireg::io::ReadOptions& read_option
   }
   for (const auto& r : result.residuals)
     require(r.allFinite());
+  if constexpr (std::is_same_v<G, bireg::SO3<double>> || std::is_same_v<G, bireg::SE3<double>> ||
+                std::is_same_v<G, bireg::Sim3<double>>) {
+    exercise_statistics(trajectory, bireg::GeodesicRegression<G>(options), result);
+  }
 }
 
 }  // namespace

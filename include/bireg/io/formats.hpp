@@ -6,7 +6,9 @@
 //   matrix  t, m00, m01, ..., m(n-1)(n-1): the covariate then the n x n
 //           matrix row-major, any group.
 //   tum     timestamp tx ty tz qx qy qz qw (seconds; quaternion w last), for
-//           SE3, or SO3 using the rotation.
+//           SE3, or SO3 using the rotation. Sim3 reads tum, euroc and kitti
+//           too, as similarities of scale 1, and writes the matrix format
+//           only (see reads<G> and supports<G>).
 //   euroc   timestamp p_x p_y p_z q_w q_x q_y q_z [more columns] (comma-
 //           separated, timestamp in integer nanoseconds, quaternion w first;
 //           columns after the eighth, such as EuRoC ground truth's
@@ -21,8 +23,8 @@
 // the largest change reported; a quaternion of norm below 1e-6 and a block
 // whose nearest rotation is not unique (rank < 2) are errors even then.
 //
-// Detection (ReadOptions::format empty): groups other than SO3 and SE3 read
-// the matrix format. For SO3 and SE3 the first data line decides: a format
+// Detection (ReadOptions::format empty): groups other than SO3, SE3 and Sim3
+// read the matrix format. For SO3, SE3 and Sim3 the first data line decides: a format
 // is a candidate when the line has its shape (matrix: 1 + n^2 numbers; tum:
 // 8 numbers, no comma; kitti: 12 numbers, no comma; euroc: 8 numbers or
 // more, comma-separated, an integer first column, and a '#' header line
@@ -52,6 +54,7 @@
 
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/line_reader.hpp"
@@ -95,6 +98,14 @@ constexpr bool is_pose_group() {
 template <class G>
 constexpr bool supports(Format format) {
   return format == Format::matrix || is_pose_group<G>();
+}
+// Whether a trajectory of G can be read from `format`: Sim(3) also reads the
+// pose formats, a rigid pose being a similarity of scale 1 (bireg_fit
+// --group auto reads SE(3) and Sim(3) data in one pass this way). Writing
+// is by `supports`: a similarity has no TUM, EuRoC or KITTI spelling.
+template <class G>
+constexpr bool reads(Format format) {
+  return supports<G>(format) || std::is_same_v<G, Sim3<double>>;
 }
 // Whether ReadOptions::project applies to G.
 template <class G>
@@ -171,6 +182,7 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
   constexpr int n = matrix_side<G>();
   constexpr bool is_se3 = std::is_same_v<G, SE3<double>>;
   constexpr bool is_so3 = std::is_same_v<G, SO3<double>>;
+  constexpr bool is_sim3 = std::is_same_v<G, Sim3<double>>;
   double x[17];
   const auto parse = [&](std::size_t first, std::size_t count) -> std::optional<std::string> {
     for (std::size_t i = 0; i < count; ++i) {
@@ -266,7 +278,7 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
     from_rotation = true;
   }
   if (from_rotation) {
-    if constexpr (is_se3) {
+    if constexpr (is_se3 || is_sim3) {
       g.setIdentity();
       g.template topLeftCorner<3, 3>() = r;
       g.template topRightCorner<3, 1>() = p;
@@ -325,7 +337,7 @@ template <class G>
 std::optional<ParseError> read_trajectory(ByteSource& source, const ReadOptions& options,
                                           Trajectory<G>& out) {
   out = Trajectory<G>();
-  if (options.format && !supports<G>(*options.format)) {
+  if (options.format && !reads<G>(*options.format)) {
     return ParseError{0, std::string("the ") + to_string(*options.format) +
                              " format holds SE3 or SO3 poses, not " + G::name};
   }
@@ -333,7 +345,7 @@ std::optional<ParseError> read_trajectory(ByteSource& source, const ReadOptions&
     return ParseError{0, std::string("--project applies to SO2, SO3, SE2 and SE3, not ") + G::name};
   }
   std::optional<Format> format = options.format;
-  if (!format && !is_pose_group<G>()) format = Format::matrix;
+  if (!format && !reads<G>(Format::tum)) format = Format::matrix;
   LineReader reader(source);
   std::string_view line;
   std::vector<std::string_view> tokens;

@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstring>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -144,6 +145,10 @@ template <class G>
 std::optional<std::string> write_trajectory(std::FILE* file, Format format, Format source,
                                             const std::vector<Timestamp>& times,
                                             const std::vector<typename G::Element>& poses) {
+  if (!supports<G>(format)) {
+    return std::string("the ") + to_string(format) + " format holds SE3 or SO3 poses, not " +
+           G::name + " (use the matrix format)";
+  }
   std::string buffer = header_line(format);
   const auto flush_buffer = [&]() -> bool {
     errno = 0;
@@ -165,10 +170,16 @@ std::optional<std::string> write_trajectory(std::FILE* file, Format format, Form
   return std::nullopt;
 }
 
-// The same text in a string (for tests and in-memory use).
+// The same text in a string (for tests and in-memory use). Throws
+// std::invalid_argument if G has no spelling in `format` (supports<G>):
+// writing a similarity as a TUM pose would drop its scale.
 template <class G>
 std::string format_trajectory(Format format, Format source, const std::vector<Timestamp>& times,
                               const std::vector<typename G::Element>& poses) {
+  if (!supports<G>(format)) {
+    throw std::invalid_argument(std::string("format_trajectory: the ") + to_string(format) +
+                                " format holds SE3 or SO3 poses, not " + G::name);
+  }
   std::string out = header_line(format);
   for (std::size_t i = 0; i < poses.size(); ++i)
     append_observation<G>(out, format, timestamp_text(times[i], source, format), poses[i]);

@@ -14,9 +14,24 @@
 //                     the Rn<3> fit above                                     k = 12
 //   screw             P(t) = the SE(3) geodesic fit (Definition 2.1)          k = 12
 //
-// Residuals live in one common space, r_i = log_SE3(P(t_i)^{-1} f_i), and
-// S = (1/N) sum r_i r_i^T. The criterion is the Bayesian information
-// criterion on the half scale of a negative log-likelihood:
+// Similarities f_i = [s_i R_i p_i; 0 1] (Sim(3), a monocular reconstruction
+// whose scale may drift; ModelSelectionOptions::group = PoseGroup::sim3):
+// the five models above fitted to the rigid parts (R_i, p_i), each with a
+// constant scale s_bar = exp(mean log s_i) (one parameter more:
+// P(t) = rigid P(t) times the dilation diag(s_bar I, 1) on the right, which
+// scales the rotation block and keeps the positions), static being the
+// Sim(3) mean (k = 7), and a sixth candidate,
+//
+//   similarity        P(t) = the Sim(3) geodesic fit                          k = 14
+//
+// the screw with a steadily changing scale. Each constant-scale model is a
+// Sim(3) model nested in `similarity` or in another (a geodesic times a
+// constant element is a geodesic whose log-scale velocity is zero).
+//
+// Residuals live in one common space, r_i = log(P(t_i)^{-1} f_i) in SE(3)
+// (d = 6) or Sim(3) (d = 7), and S = (1/N) sum r_i r_i^T. The criterion is
+// the Bayesian information criterion on the half scale of a negative
+// log-likelihood:
 //
 //   C = N/2 log det S + k/2 log N,
 //
@@ -27,22 +42,27 @@
 //
 // Invariance (Hanik & von Tycowicz, Theorem 2.4). Left translation f -> h f
 // (a change of the world frame for camera-to-world poses) moves every
-// candidate's prediction to h P(t): the SE(3), SO(3) and Rn<3> fits and both
-// means are left equivariant, and p -> R_h p + t_h maps lines to lines and
-// means to means. So every r_i, every C, the CV errors and the verdict are
-// unchanged. Right translation f -> f h (a change of the body frame) maps the
-// static and screw residuals by Ad_{h^{-1}}, so det S changes by
-// det(Ad)^2 = 1 and their C is unchanged; the three sub-models are not closed
-// under it (a fixed position of the body origin is not a fixed position of
-// another body point when the body rotates), so their C, and so possibly
-// the verdict, depends on which body point is tracked: exact invariance is
+// candidate's prediction to h P(t): the geodesic fits and means are left
+// equivariant, p -> R_h p + t_h (Sim(3): s_h R_h p + t_h) maps lines to
+// lines and means to means, and the SE(3) fit of the rigid parts commutes
+// with the scaling of translations (an automorphism of SE(3), which commutes
+// with exp, log and their differentials). So every r_i, every C, the CV
+// errors and the verdict are unchanged. Right translation f -> f h (a change
+// of the body frame) maps the residuals of the models closed under it
+// (static and screw; for Sim(3) data static and similarity) by Ad_{h^{-1}}:
+// det Ad = 1 in SE(3), so their C is unchanged; det Ad_{h^{-1}} = s_h^{-3} in
+// Sim(3), so both of their criteria shift by the same -3 N log s_h and their
+// comparison is unchanged. The other sub-models are not closed under it (a
+// fixed position of the body origin is not a fixed position of another
+// body point when the body rotates), so their C, and so possibly the
+// verdict, depends on which body point is tracked: exact invariance is
 // impossible for them and is not claimed.
 //
 // Singular S (planar motion, noise-free data): the eigenvalues of every
 // candidate's S are floored at kDeterminantFloor times the largest
 // eigenvalue of the static model's S (the data's own spread, common to all
 // candidates), and at the smallest normal double if the data are all equal.
-// A perfect fit then scores 6 N/2 log(floor), the best possible, never -inf
+// A perfect fit then scores d N/2 log(floor), the best possible, never -inf
 // or NaN.
 //
 // Recommendation: among the candidates whose C is within kSelectionMargin
@@ -64,10 +84,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -76,13 +98,24 @@
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/rn.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/mean.hpp"
 
 namespace bireg {
 
-enum class MotionModel { static_pose, rotation_only, translation_only, rotation_and_line, screw };
+enum class MotionModel {
+  static_pose,
+  rotation_only,
+  translation_only,
+  rotation_and_line,
+  screw,
+  similarity
+};
+
+// The group the poses are elements of, and the residuals' space.
+enum class PoseGroup { se3, sim3 };
 
 inline const char* to_string(MotionModel model) {
   switch (model) {
@@ -96,29 +129,38 @@ inline const char* to_string(MotionModel model) {
       return "rotation_and_line";
     case MotionModel::screw:
       return "screw";
+    case MotionModel::similarity:
+      return "similarity";
   }
   return "unknown";
 }
 
-inline int parameter_count(MotionModel model) {
+// k of the criterion: for Sim(3) data every model but `similarity` has one
+// parameter more than for SE(3) data (its constant scale).
+inline int parameter_count(MotionModel model, PoseGroup group = PoseGroup::se3) {
+  const int constant_scale = group == PoseGroup::sim3 ? 1 : 0;
   switch (model) {
     case MotionModel::static_pose:
-      return 6;
+      return 6 + constant_scale;
     case MotionModel::rotation_only:
-      return 9;
     case MotionModel::translation_only:
-      return 9;
+      return 9 + constant_scale;
     case MotionModel::rotation_and_line:
-      return 12;
     case MotionModel::screw:
-      return 12;
+      return 12 + constant_scale;
+    case MotionModel::similarity:
+      return 14;
   }
   return 0;
 }
 
+// The candidates for SE(3) data, and for Sim(3) data.
 inline constexpr MotionModel kMotionModels[] = {
     MotionModel::static_pose, MotionModel::rotation_only, MotionModel::translation_only,
     MotionModel::rotation_and_line, MotionModel::screw};
+inline constexpr MotionModel kSimilarityMotionModels[] = {
+    MotionModel::static_pose,       MotionModel::rotation_only, MotionModel::translation_only,
+    MotionModel::rotation_and_line, MotionModel::screw,         MotionModel::similarity};
 
 // Eigenvalues of S below this times the static model's largest are raised to it.
 inline constexpr double kDeterminantFloor = 1e-12;
@@ -126,7 +168,8 @@ inline constexpr double kDeterminantFloor = 1e-12;
 inline constexpr double kSelectionMargin = 1.0;
 
 struct ModelSelectionOptions {
-  int folds = 5;  // K of the cross-validation; below 2: no cross-validation
+  int folds = 5;                     // K of the cross-validation; below 2: no cross-validation
+  PoseGroup group = PoseGroup::se3;  // sim3: similarities, six candidates
 };
 
 struct CandidateReport {
@@ -136,6 +179,7 @@ struct CandidateReport {
   std::string note;
   double rotation_rms_degrees = 0;  // RMS of |omega part of r_i|
   double translation_rms = 0;       // RMS of |rho part of r_i|, data units
+  double log_scale_rms = 0;         // Sim(3) data: RMS of the log-scale part of r_i; else 0
   double log_det = 0;               // log det S with the eigenvalue floor
   double criterion = 0;             // N/2 log det S + k/2 log N
   std::optional<double> cv_error;   // mean held-out |r|^2; empty if a fold failed
@@ -143,9 +187,38 @@ struct CandidateReport {
   bool recommended = false;
 };
 
+// A fitted candidate: its prediction P(t), a 4x4 SE(3) (or, for Sim(3)
+// data, Sim(3)) matrix, at any covariate.
+struct MotionPrediction {
+  MotionModel model = MotionModel::static_pose;
+  std::optional<Geodesic<SO3d>> rotation_path;
+  std::optional<Geodesic<Rnd<3>>> position_path;
+  std::optional<Geodesic<SE3d>> screw_path;
+  std::optional<Geodesic<Sim3d>> similarity_path;
+  Eigen::Matrix3d fixed_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d fixed_position = Eigen::Vector3d::Zero();
+  Eigen::Matrix4d fixed_pose = Eigen::Matrix4d::Identity();
+  double scale = 1;  // the constant scale s_bar of a rigid model on Sim(3) data
+
+  Eigen::Matrix4d operator()(double t) const {
+    if (model == MotionModel::static_pose) return fixed_pose;
+    if (model == MotionModel::similarity) return (*similarity_path)(t);
+    Eigen::Matrix4d p = Eigen::Matrix4d::Identity();
+    if (model == MotionModel::screw) {
+      p = (*screw_path)(t);
+    } else {
+      p.topLeftCorner<3, 3>() = rotation_path ? (*rotation_path)(t) : fixed_rotation;
+      p.topRightCorner<3, 1>() = position_path ? (*position_path)(t) : fixed_position;
+    }
+    if (scale != 1) p.topLeftCorner<3, 3>() *= scale;
+    return p;
+  }
+};
+
 struct ModelSelection {
-  std::vector<CandidateReport> candidates;  // in the order of kMotionModels
-  std::optional<MotionModel> recommended;   // empty if no candidate could be fitted
+  std::vector<CandidateReport> candidates;     // in the order of kMotionModels (or kSimilarity...)
+  std::optional<MotionModel> recommended;      // empty if no candidate could be fitted
+  std::optional<MotionPrediction> prediction;  // the recommended model's fit
   bool ambiguous = false;  // another model of equal complexity is within the margin
   std::string message;
 };
@@ -156,54 +229,62 @@ using Pose = Eigen::Matrix4d;
 using Vector3 = Eigen::Vector3d;
 using Matrix3 = Eigen::Matrix3d;
 
-// A fitted candidate: its prediction at any covariate.
-struct Predictor {
-  MotionModel model = MotionModel::static_pose;
-  std::optional<Geodesic<SO3d>> rotation_path;
-  std::optional<Geodesic<Rnd<3>>> position_path;
-  std::optional<Geodesic<SE3d>> screw_path;
-  Matrix3 fixed_rotation = Matrix3::Identity();
-  Vector3 fixed_position = Vector3::Zero();
-  Pose fixed_pose = Pose::Identity();
+// The residuals' group for poses of `group`.
+template <PoseGroup group>
+using Ambient = std::conditional_t<group == PoseGroup::sim3, Sim3d, SE3d>;
 
-  Pose operator()(double t) const {
-    if (model == MotionModel::static_pose) return fixed_pose;
-    if (model == MotionModel::screw) return (*screw_path)(t);
-    Pose p = Pose::Identity();
-    p.topLeftCorner<3, 3>() = rotation_path ? (*rotation_path)(t) : fixed_rotation;
-    p.topRightCorner<3, 1>() = position_path ? (*position_path)(t) : fixed_position;
-    return p;
-  }
-};
-
-template <class Poses>
-std::optional<Predictor> fit_model(MotionModel model, const Poses& poses,
-                                   const std::vector<double>& times) {
-  Predictor predictor;
+template <PoseGroup group, class Poses>
+std::optional<MotionPrediction> fit_model(MotionModel model, const Poses& poses,
+                                          const std::vector<double>& times) {
+  using G = Ambient<group>;
+  MotionPrediction predictor;
   predictor.model = model;
   const std::size_t n = poses.size();
+  if (model == MotionModel::static_pose) {
+    const auto m = mean<G>(poses);
+    if (!m.ok()) return std::nullopt;
+    predictor.fixed_pose = *m.mean;
+    return predictor;
+  }
+  if (model == MotionModel::similarity) {
+    if constexpr (group == PoseGroup::sim3) {
+      const auto fit = GeodesicRegression<Sim3d>().fit(poses, times);
+      if (!fit.ok()) return std::nullopt;
+      predictor.similarity_path = fit.geodesic;
+      return predictor;
+    } else {
+      return std::nullopt;  // SE(3) data have no scale to move
+    }
+  }
+  // The rigid parts (R_i, p_i); for similarities s_i = det(s_i R_i)^(1/3).
+  std::vector<Pose> rigid(n);
+  for (std::size_t i = 0; i < n; ++i)
+    rigid[i] = poses[i];
+  if constexpr (group == PoseGroup::sim3) {
+    double log_scale_sum = 0;
+    for (Pose& f : rigid) {
+      const double log_scale = std::log(f.topLeftCorner<3, 3>().determinant()) / 3;
+      f.topLeftCorner<3, 3>() *= std::exp(-log_scale);
+      log_scale_sum += log_scale;
+    }
+    predictor.scale = std::exp(log_scale_sum / static_cast<double>(n));
+  }
+  if (model == MotionModel::screw) {
+    const auto fit = GeodesicRegression<SE3d>().fit(rigid, times);
+    if (!fit.ok()) return std::nullopt;
+    predictor.screw_path = fit.geodesic;
+    return predictor;
+  }
   std::vector<Matrix3> rotations(n);
   std::vector<Vector3> positions(n);
   for (std::size_t i = 0; i < n; ++i) {
-    rotations[i] = poses[i].template topLeftCorner<3, 3>();
-    positions[i] = poses[i].template topRightCorner<3, 1>();
+    rotations[i] = rigid[i].template topLeftCorner<3, 3>();
+    positions[i] = rigid[i].template topRightCorner<3, 1>();
   }
   const bool moving_rotation =
       model == MotionModel::rotation_only || model == MotionModel::rotation_and_line;
   const bool moving_position =
       model == MotionModel::translation_only || model == MotionModel::rotation_and_line;
-  if (model == MotionModel::static_pose) {
-    const auto m = mean<SE3d>(poses);
-    if (!m.ok()) return std::nullopt;
-    predictor.fixed_pose = *m.mean;
-    return predictor;
-  }
-  if (model == MotionModel::screw) {
-    const auto fit = GeodesicRegression<SE3d>().fit(poses, times);
-    if (!fit.ok()) return std::nullopt;
-    predictor.screw_path = fit.geodesic;
-    return predictor;
-  }
   if (moving_rotation) {
     const auto fit = GeodesicRegression<SO3d>().fit(rotations, times);
     if (!fit.ok()) return std::nullopt;
@@ -225,8 +306,11 @@ std::optional<Predictor> fit_model(MotionModel model, const Poses& poses,
   return predictor;
 }
 
-inline SE3d::Tangent residual(const Predictor& predictor, const Pose& pose, double t) {
-  return SE3d::log(SE3d::compose(SE3d::inverse(predictor(t)), pose));
+template <PoseGroup group>
+typename Ambient<group>::Tangent residual(const MotionPrediction& predictor, const Pose& pose,
+                                          double t) {
+  using G = Ambient<group>;
+  return G::log(G::compose(G::inverse(predictor(t)), pose));
 }
 
 // Fold of observation i: rank of (t_i, i) modulo K.
@@ -241,7 +325,7 @@ inline std::vector<int> fold_of(const std::vector<double>& times, int folds) {
   return fold;
 }
 
-template <class Poses>
+template <PoseGroup group, class Poses>
 std::optional<double> cv_error(MotionModel model, const Poses& poses,
                                const std::vector<double>& times, int folds) {
   const std::vector<int> fold = fold_of(times, folds);
@@ -254,49 +338,38 @@ std::optional<double> cv_error(MotionModel model, const Poses& poses,
       train_poses.push_back(poses[i]);
       train_times.push_back(times[i]);
     }
-    const auto predictor = fit_model(model, train_poses, train_times);
+    const auto predictor = fit_model<group>(model, train_poses, train_times);
     if (!predictor) return std::nullopt;
     for (std::size_t i = 0; i < poses.size(); ++i)
-      if (fold[i] == k) squared_sum += residual(*predictor, poses[i], times[i]).squaredNorm();
+      if (fold[i] == k)
+        squared_sum += residual<group>(*predictor, poses[i], times[i]).squaredNorm();
   }
   return squared_sum / static_cast<double>(poses.size());
 }
 
-inline Eigen::Matrix<double, 6, 6> residual_covariance(const std::vector<SE3d::Tangent>& r) {
-  Eigen::Matrix<double, 6, 6> s = Eigen::Matrix<double, 6, 6>::Zero();
+template <class Tangent>
+auto residual_covariance(const std::vector<Tangent>& r) {
+  using Square = Eigen::Matrix<double, Tangent::RowsAtCompileTime, Tangent::RowsAtCompileTime>;
+  Square s = Square::Zero();
   for (const auto& ri : r)
     s += ri * ri.transpose();
-  return s / static_cast<double>(r.size());
+  return Square(s / static_cast<double>(r.size()));
 }
 
-inline double floored_log_det(const Eigen::Matrix<double, 6, 6>& s, double floor) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(s, Eigen::EigenvaluesOnly);
+template <class Square>
+double floored_log_det(const Square& s, double floor) {
+  const Eigen::SelfAdjointEigenSolver<Square> eigen(s, Eigen::EigenvaluesOnly);
   double log_det = 0;
-  for (int j = 0; j < 6; ++j)
+  for (Eigen::Index j = 0; j < s.rows(); ++j)
     log_det += std::log(std::max(eigen.eigenvalues()[j], floor));
   return log_det;
 }
 
-}  // namespace model_selection_detail
-
-// One candidate fitted alone: its prediction P(t) at any covariate (what
-// bireg_fit --group auto writes for the recommended model), or nothing if
-// its fit failed.
-using MotionPrediction = model_selection_detail::Predictor;
-template <class Poses>
-std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses& poses,
-                                                 const std::vector<double>& times) {
-  return model_selection_detail::fit_model(model, poses, times);
-}
-
-// Compare the five pose-motion models on `poses` (indexable 4x4 SE(3)
-// matrices with size()) at covariates `times`. Never throws for bad data,
-// never returns NaN: a model that cannot be fitted (N below its parameter
-// count, a failed fit) is excluded with a note.
-template <class Poses>
-ModelSelection select_motion_model(const Poses& poses, const std::vector<double>& times,
-                                   const ModelSelectionOptions& options = {}) {
-  namespace detail = model_selection_detail;
+template <PoseGroup group, class Poses>
+ModelSelection select(const Poses& poses, const std::vector<double>& times,
+                      const ModelSelectionOptions& options) {
+  using G = Ambient<group>;
+  using Tangent = typename G::Tangent;
   ModelSelection selection;
   const std::size_t n = poses.size();
   if (n != times.size() || n == 0) {
@@ -306,25 +379,27 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
   const double n_real = static_cast<double>(n);
   const double rad_to_deg = 180.0 / 3.14159265358979323846;
 
-  std::vector<std::optional<detail::Predictor>> predictors;
-  std::vector<std::vector<SE3d::Tangent>> residuals;
-  for (MotionModel model : kMotionModels) {
+  std::vector<MotionModel> models(std::begin(kMotionModels), std::end(kMotionModels));
+  if (group == PoseGroup::sim3) models.push_back(MotionModel::similarity);
+  std::vector<std::optional<MotionPrediction>> predictors;
+  std::vector<std::vector<Tangent>> residuals;
+  for (MotionModel model : models) {
     CandidateReport report;
     report.model = model;
-    report.parameters = parameter_count(model);
-    std::optional<detail::Predictor> predictor;
+    report.parameters = parameter_count(model, group);
+    std::optional<MotionPrediction> predictor;
     if (n_real < report.parameters) {
       report.note = "excluded: " + std::to_string(n) + " observations, fewer than its " +
                     std::to_string(report.parameters) + " parameters";
     } else {
-      predictor = detail::fit_model(model, poses, times);
+      predictor = fit_model<group>(model, poses, times);
       if (!predictor) report.note = "excluded: its fit failed";
     }
-    std::vector<SE3d::Tangent> r;
+    std::vector<Tangent> r;
     if (predictor) {
       report.fitted = true;
       for (std::size_t i = 0; i < n; ++i)
-        r.push_back(detail::residual(*predictor, poses[i], times[i]));
+        r.push_back(residual<group>(*predictor, poses[i], times[i]));
     }
     predictors.push_back(predictor);
     residuals.push_back(r);
@@ -333,14 +408,17 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
 
   // The floor's reference: the largest eigenvalue of the static model's S
   // (computed directly if static itself was excluded).
-  std::vector<SE3d::Tangent> spread = residuals.front();
+  std::vector<Tangent> spread = residuals.front();
   if (spread.empty()) {
     for (std::size_t i = 0; i < n; ++i)
-      spread.push_back(SE3d::log(SE3d::compose(SE3d::inverse(poses[n / 2]), poses[i])));
+      spread.push_back(G::log(G::compose(G::inverse(poses[n / 2]), poses[i])));
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> spread_eigen(
-      detail::residual_covariance(spread), Eigen::EigenvaluesOnly);
-  const double largest_spread = spread_eigen.eigenvalues()[5];
+  const auto spread_covariance = residual_covariance(spread);
+  const double largest_spread =
+      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
+          spread_covariance, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
   const double floor =
       std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
 
@@ -348,17 +426,19 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
   for (std::size_t c = 0; c < selection.candidates.size(); ++c) {
     CandidateReport& report = selection.candidates[c];
     if (!report.fitted) continue;
-    double rotation_squares = 0, translation_squares = 0;
+    double rotation_squares = 0, translation_squares = 0, scale_squares = 0;
     for (const auto& ri : residuals[c]) {
-      translation_squares += ri.head<3>().squaredNorm();
-      rotation_squares += ri.tail<3>().squaredNorm();
+      translation_squares += ri.template head<3>().squaredNorm();
+      rotation_squares += ri.template segment<3>(3).squaredNorm();
+      if constexpr (group == PoseGroup::sim3) scale_squares += ri[6] * ri[6];
     }
     report.rotation_rms_degrees = std::sqrt(rotation_squares / n_real) * rad_to_deg;
     report.translation_rms = std::sqrt(translation_squares / n_real);
-    report.log_det = detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
+    report.log_scale_rms = std::sqrt(scale_squares / n_real);
+    report.log_det = floored_log_det(residual_covariance(residuals[c]), floor);
     report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
     if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds))
-      report.cv_error = detail::cv_error(report.model, poses, times, options.folds);
+      report.cv_error = cv_error<group>(report.model, poses, times, options.folds);
     if (!best || report.criterion < *best) best = report.criterion;
   }
   if (!best) {
@@ -381,6 +461,7 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
   CandidateReport& winner = selection.candidates[*chosen];
   winner.recommended = true;
   selection.recommended = winner.model;
+  selection.prediction = predictors[*chosen];
   for (std::size_t c = 0; c < selection.candidates.size(); ++c) {
     const CandidateReport& other = selection.candidates[c];
     if (c != *chosen && other.within_margin && other.parameters == winner.parameters) {
@@ -390,6 +471,36 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
     }
   }
   return selection;
+}
+
+}  // namespace model_selection_detail
+
+// One candidate fitted alone: its prediction P(t) at any covariate, or
+// nothing if its fit failed (or `model` is `similarity` and the poses are
+// SE(3)).
+template <class Poses>
+std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses& poses,
+                                                 const std::vector<double>& times,
+                                                 PoseGroup group = PoseGroup::se3) {
+  namespace detail = model_selection_detail;
+  if (group == PoseGroup::sim3) return detail::fit_model<PoseGroup::sim3>(model, poses, times);
+  return detail::fit_model<PoseGroup::se3>(model, poses, times);
+}
+
+// Compare the pose-motion models on `poses` (indexable 4x4 matrices with
+// size(): SE(3) elements, or Sim(3) ones with options.group = sim3) at
+// covariates `times`: the five rigid candidates, and for similarities the
+// sixth, `similarity`. Never throws for bad data, never returns NaN: a model
+// that cannot be fitted (N below its parameter count, a failed fit) is
+// excluded with a note. The recommended model's fit is returned with the
+// table (`prediction`), so the caller need not refit it.
+template <class Poses>
+ModelSelection select_motion_model(const Poses& poses, const std::vector<double>& times,
+                                   const ModelSelectionOptions& options = {}) {
+  namespace detail = model_selection_detail;
+  if (options.group == PoseGroup::sim3)
+    return detail::select<PoseGroup::sim3>(poses, times, options);
+  return detail::select<PoseGroup::se3>(poses, times, options);
 }
 
 }  // namespace bireg
