@@ -309,3 +309,85 @@ TEST_CASE("SE(3) data have no similarity candidate") {
   CHECK_FALSE(
       bireg::fit_motion_model(MotionModel::similarity, scene.poses, scene.times).has_value());
 }
+
+// Rotation data (issue 18: "for rotation data, static vs geodesic"):
+// N = 60 on [0, 1], noise 0.01 rad per axis applied on the right, a static
+// orientation or a rotation by 0.6 rad (60 noise levels) over the interval;
+// 200 replicates each, the same binomial bound as above. On SO(3) det Ad = 1
+// and both candidates are bi-equivariant, so the criteria are left and right
+// invariant (1e-9 relative, as above).
+namespace {
+struct RotationScene {
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<double> times;
+};
+
+RotationScene rotation_scene(bool moves, std::mt19937& rng) {
+  std::normal_distribution<double> normal(0.0, kNoise);
+  const Eigen::Matrix3d r0 = bireg::SO3d::exp(Eigen::Vector3d(0.3, 0.1, -0.2));
+  const Eigen::Vector3d omega(0.2, -0.3, 0.5);  // 0.62 rad over [0, 1]
+  RotationScene scene;
+  for (int i = 0; i < kObservations; ++i) {
+    const double t = static_cast<double>(i) / (kObservations - 1);
+    const Eigen::Vector3d e(normal(rng), normal(rng), normal(rng));
+    scene.rotations.push_back(r0 * bireg::SO3d::exp((moves ? t : 0.0) * omega) *
+                              bireg::SO3d::exp(e));
+    scene.times.push_back(t);
+  }
+  return scene;
+}
+}  // namespace
+
+TEST_CASE("rotation data: static or geodesic, recovered and invariant") {
+  using bireg::TrendModel;
+  for (const bool moves : {false, true}) {
+    std::mt19937 rng(moves ? 77u : 78u);
+    int recovered = 0;
+    for (int rep = 0; rep < 200; ++rep) {
+      const RotationScene scene = rotation_scene(moves, rng);
+      const auto s = bireg::select_static_or_geodesic<bireg::SO3d>(scene.rotations, scene.times);
+      REQUIRE(s.recommended.has_value());
+      REQUIRE(s.candidates.size() == 2);
+      CHECK(s.candidates[0].parameters == 3);
+      CHECK(s.candidates[1].parameters == 6);
+      if (*s.recommended == (moves ? TrendModel::geodesic : TrendModel::static_element))
+        ++recovered;
+    }
+    std::printf("SO3  %-18s recovered %3d/200\n", moves ? "geodesic" : "static", recovered);
+    CHECK(recovered >= 190);
+  }
+
+  std::mt19937 rng(79);
+  const RotationScene scene = rotation_scene(true, rng);
+  const Eigen::Matrix3d h = bireg::SO3d::exp(Eigen::Vector3d(0.9, -1.3, 0.4));
+  RotationScene left = scene, right = scene;
+  for (auto& r : left.rotations)
+    r = h * r;
+  for (auto& r : right.rotations)
+    r = r * h;
+  const auto base = bireg::select_static_or_geodesic<bireg::SO3d>(scene.rotations, scene.times);
+  const auto l = bireg::select_static_or_geodesic<bireg::SO3d>(left.rotations, left.times);
+  const auto r = bireg::select_static_or_geodesic<bireg::SO3d>(right.rotations, right.times);
+  for (std::size_t c = 0; c < 2; ++c) {
+    const double scale = std::max(1.0, std::abs(base.candidates[c].criterion));
+    CHECK(std::abs(l.candidates[c].criterion - base.candidates[c].criterion) <= 1e-9 * scale);
+    CHECK(std::abs(r.candidates[c].criterion - base.candidates[c].criterion) <= 1e-9 * scale);
+    REQUIRE(base.candidates[c].cv_error.has_value());
+    CHECK(std::abs(*l.candidates[c].cv_error - *base.candidates[c].cv_error) <=
+          1e-9 * *base.candidates[c].cv_error);
+  }
+  REQUIRE(base.geodesic.has_value());
+  REQUIRE(base.static_element.has_value());
+
+  // Five rotations: fewer than the geodesic's 6 parameters.
+  RotationScene few = scene;
+  few.rotations.resize(5);
+  few.times.resize(5);
+  const auto f = bireg::select_static_or_geodesic<bireg::SO3d>(few.rotations, few.times);
+  REQUIRE(f.recommended == TrendModel::static_element);
+  CHECK_FALSE(f.candidates[1].fitted);
+  CHECK(f.candidates[1].note.find("fewer than its 6 parameters") != std::string::npos);
+  const auto none = bireg::select_static_or_geodesic<bireg::SO3d>(std::vector<Eigen::Matrix3d>{},
+                                                                  std::vector<double>{});
+  CHECK_FALSE(none.recommended.has_value());
+}

@@ -28,6 +28,18 @@
 // Sim(3) model nested in `similarity` or in another (a geodesic times a
 // constant element is a geodesic whose log-scale velocity is zero).
 //
+// Data of any group G (orientations: SO(3)): does the element move along
+// the covariate at all? select_static_or_geodesic compares
+//
+//   static            P(t) = m, the bi-invariant mean                          k = d
+//   geodesic          P(t) = the geodesic fit                                  k = 2d
+//
+// (d = G::dof) with residuals log(P(t_i)^{-1} f_i) in G, and the same
+// criterion, eigenvalue floor, margin and cross-validation as below. Both
+// candidates are left and right equivariant (Theorem 2.4), so the criteria
+// are left invariant, and right invariant where det Ad = 1 (SO(3), SE(3):
+// every group whose Ad is orthogonal or unimodular).
+//
 // Residuals live in one common space, r_i = log(P(t_i)^{-1} f_i) in SE(3)
 // (d = 6) or Sim(3) (d = 7), and S = (1/N) sum r_i r_i^T. The criterion is
 // the Bayesian information criterion on the half scale of a negative
@@ -474,6 +486,167 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
 }
 
 }  // namespace model_selection_detail
+
+enum class TrendModel { static_element, geodesic };
+
+inline const char* to_string(TrendModel model) {
+  return model == TrendModel::static_element ? "static" : "geodesic";
+}
+
+struct TrendCandidate {
+  TrendModel model = TrendModel::static_element;
+  int parameters = 0;
+  bool fitted = false;  // false: excluded, `note` says why
+  std::string note;
+  double residual_rms = 0;         // RMS of |r_i| in G's tangent coordinates
+  double log_det = 0;              // log det S with the eigenvalue floor
+  double criterion = 0;            // N/2 log det S + k/2 log N
+  std::optional<double> cv_error;  // mean held-out |r|^2; empty if a fold failed
+  bool within_margin = false;      // C <= best C + kSelectionMargin
+  bool recommended = false;
+};
+
+template <class G>
+struct TrendSelection {
+  std::vector<TrendCandidate> candidates;             // static, then geodesic
+  std::optional<TrendModel> recommended;              // empty if neither could be fitted
+  std::optional<typename G::Element> static_element;  // the mean, if fitted
+  std::optional<Geodesic<G>> geodesic;                // the geodesic fit, if fitted
+  std::string message;
+};
+
+namespace model_selection_detail {
+
+// The prediction of a static or geodesic candidate fitted to `observations`.
+template <class G, class Observations>
+std::optional<Geodesic<G>> fit_trend_model(TrendModel model, const Observations& observations,
+                                           const std::vector<double>& times) {
+  if (model == TrendModel::static_element) {
+    const auto m = mean<G>(observations);
+    if (!m.ok()) return std::nullopt;
+    return Geodesic<G>(*m.mean, *m.mean, 0.0, 1.0);
+  }
+  const auto fit = GeodesicRegression<G>().fit(observations, times);
+  if (!fit.ok()) return std::nullopt;
+  return fit.geodesic;
+}
+
+template <class G>
+typename G::Tangent trend_residual(const Geodesic<G>& prediction,
+                                   const typename G::Element& observation, double t) {
+  return G::log(G::compose(G::inverse(prediction(t)), observation));
+}
+
+}  // namespace model_selection_detail
+
+// Static against geodesic for `observations` of any group G (indexable,
+// with size()) at covariates `times`: the recommendation is the static
+// model unless the geodesic's criterion is lower by more than
+// kSelectionMargin. Never throws for bad data, never returns NaN: a model
+// that cannot be fitted (N below its parameter count, a failed fit) is
+// excluded with a note.
+template <class G, class Observations>
+TrendSelection<G> select_static_or_geodesic(const Observations& observations,
+                                            const std::vector<double>& times,
+                                            const ModelSelectionOptions& options = {}) {
+  namespace detail = model_selection_detail;
+  using Tangent = typename G::Tangent;
+  TrendSelection<G> selection;
+  const std::size_t n = observations.size();
+  if (n != times.size() || n == 0) {
+    selection.message = "observations and times must be non-empty and of equal length";
+    return selection;
+  }
+  const double n_real = static_cast<double>(n);
+  std::vector<std::vector<Tangent>> residuals;
+  for (TrendModel model : {TrendModel::static_element, TrendModel::geodesic}) {
+    TrendCandidate report;
+    report.model = model;
+    report.parameters = (model == TrendModel::static_element ? 1 : 2) * G::dof;
+    std::optional<Geodesic<G>> prediction;
+    if (n_real < report.parameters) {
+      report.note = "excluded: " + std::to_string(n) + " observations, fewer than its " +
+                    std::to_string(report.parameters) + " parameters";
+    } else {
+      prediction = detail::fit_trend_model<G>(model, observations, times);
+      if (!prediction) report.note = "excluded: its fit failed";
+    }
+    std::vector<Tangent> r;
+    if (prediction) {
+      report.fitted = true;
+      for (std::size_t i = 0; i < n; ++i)
+        r.push_back(detail::trend_residual<G>(*prediction, observations[i], times[i]));
+      if (model == TrendModel::static_element) {
+        selection.static_element = (*prediction)(0.0);
+      } else {
+        selection.geodesic = prediction;
+      }
+    }
+    residuals.push_back(r);
+    selection.candidates.push_back(report);
+  }
+  // The floor's reference: the static model's S, or the spread about the
+  // middle observation if the mean failed.
+  std::vector<Tangent> spread = residuals.front();
+  if (spread.empty()) {
+    for (std::size_t i = 0; i < n; ++i)
+      spread.push_back(G::log(G::compose(G::inverse(observations[n / 2]), observations[i])));
+  }
+  const auto spread_covariance = detail::residual_covariance(spread);
+  const double largest_spread =
+      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
+          spread_covariance, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
+  const double floor =
+      std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
+  std::optional<double> best;
+  for (std::size_t c = 0; c < selection.candidates.size(); ++c) {
+    TrendCandidate& report = selection.candidates[c];
+    if (!report.fitted) continue;
+    double squares = 0;
+    for (const auto& ri : residuals[c])
+      squares += ri.squaredNorm();
+    report.residual_rms = std::sqrt(squares / n_real);
+    report.log_det = detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
+    report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
+    if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
+      const std::vector<int> fold = detail::fold_of(times, options.folds);
+      double held_out = 0;
+      for (int k = 0; k < options.folds; ++k) {
+        std::vector<typename G::Element> train;
+        std::vector<double> train_times;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (fold[i] == k) continue;
+          train.push_back(observations[i]);
+          train_times.push_back(times[i]);
+        }
+        const auto fold_fit = detail::fit_trend_model<G>(report.model, train, train_times);
+        if (!fold_fit) {
+          held_out = -1;  // a failed fold: no CV error
+          break;
+        }
+        for (std::size_t i = 0; i < n; ++i)
+          if (fold[i] == k)
+            held_out +=
+                detail::trend_residual<G>(*fold_fit, observations[i], times[i]).squaredNorm();
+      }
+      if (held_out >= 0) report.cv_error = held_out / n_real;
+    }
+    if (!best || report.criterion < *best) best = report.criterion;
+  }
+  if (!best) {
+    selection.message = "neither model could be fitted";
+    return selection;
+  }
+  // The static model has fewer parameters: it wins within the margin.
+  for (TrendCandidate& report : selection.candidates)
+    report.within_margin = report.fitted && report.criterion <= *best + kSelectionMargin;
+  TrendCandidate& winner = selection.candidates[selection.candidates[0].within_margin ? 0 : 1];
+  winner.recommended = true;
+  selection.recommended = winner.model;
+  return selection;
+}
 
 // One candidate fitted alone: its prediction P(t) at any covariate, or
 // nothing if its fit failed (or `model` is `similarity` and the poses are
