@@ -337,26 +337,30 @@ inline std::vector<int> fold_of(const std::vector<double>& times, int folds) {
   return fold;
 }
 
-template <PoseGroup group, class Poses>
-std::optional<double> cv_error(MotionModel model, const Poses& poses,
-                               const std::vector<double>& times, int folds) {
+// K-fold cross-validated prediction error: the mean over i of
+// |residual(the prediction fitted without i's fold, f_i, t_i)|^2, or
+// nothing if a fold's fit fails. `fit(train, train_times)` returns an
+// optional prediction; training sets are vectors of Element.
+template <class Element, class Observations, class Fit, class Residual>
+std::optional<double> cv_error(const Observations& observations, const std::vector<double>& times,
+                               int folds, const Fit& fit, const Residual& residual) {
   const std::vector<int> fold = fold_of(times, folds);
   double squared_sum = 0;
   for (int k = 0; k < folds; ++k) {
-    std::vector<Pose> train_poses;
+    std::vector<Element> train;
     std::vector<double> train_times;
-    for (std::size_t i = 0; i < poses.size(); ++i) {
+    for (std::size_t i = 0; i < observations.size(); ++i) {
       if (fold[i] == k) continue;
-      train_poses.push_back(poses[i]);
+      train.push_back(observations[i]);
       train_times.push_back(times[i]);
     }
-    const auto predictor = fit_model<group>(model, train_poses, train_times);
-    if (!predictor) return std::nullopt;
-    for (std::size_t i = 0; i < poses.size(); ++i)
+    const auto prediction = fit(train, train_times);
+    if (!prediction) return std::nullopt;
+    for (std::size_t i = 0; i < observations.size(); ++i)
       if (fold[i] == k)
-        squared_sum += residual<group>(*predictor, poses[i], times[i]).squaredNorm();
+        squared_sum += residual(*prediction, observations[i], times[i]).squaredNorm();
   }
-  return squared_sum / static_cast<double>(poses.size());
+  return squared_sum / static_cast<double>(observations.size());
 }
 
 template <class Tangent>
@@ -366,6 +370,27 @@ auto residual_covariance(const std::vector<Tangent>& r) {
   for (const auto& ri : r)
     s += ri * ri.transpose();
   return Square(s / static_cast<double>(r.size()));
+}
+
+// The eigenvalue floor of every candidate's S: kDeterminantFloor times the
+// largest eigenvalue of the static model's S (`spread`: its residuals), or,
+// if the static model was excluded (`spread` empty), of the spread about
+// the middle observation; at least the smallest normal double.
+template <class G, class Observations>
+double determinant_floor(std::vector<typename G::Tangent> spread,
+                         const Observations& observations) {
+  const std::size_t n = observations.size();
+  if (spread.empty()) {
+    for (std::size_t i = 0; i < n; ++i)
+      spread.push_back(G::log(G::compose(G::inverse(observations[n / 2]), observations[i])));
+  }
+  const auto spread_covariance = residual_covariance(spread);
+  const double largest_spread =
+      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
+          spread_covariance, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .maxCoeff();
+  return std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
 }
 
 template <class Square>
@@ -418,21 +443,7 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
     selection.candidates.push_back(report);
   }
 
-  // The floor's reference: the largest eigenvalue of the static model's S
-  // (computed directly if static itself was excluded).
-  std::vector<Tangent> spread = residuals.front();
-  if (spread.empty()) {
-    for (std::size_t i = 0; i < n; ++i)
-      spread.push_back(G::log(G::compose(G::inverse(poses[n / 2]), poses[i])));
-  }
-  const auto spread_covariance = residual_covariance(spread);
-  const double largest_spread =
-      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
-          spread_covariance, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-  const double floor =
-      std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
+  const double floor = determinant_floor<G>(residuals.front(), poses);
 
   std::optional<double> best;
   for (std::size_t c = 0; c < selection.candidates.size(); ++c) {
@@ -450,7 +461,12 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
     report.log_det = floored_log_det(residual_covariance(residuals[c]), floor);
     report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
     if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds))
-      report.cv_error = cv_error<group>(report.model, poses, times, options.folds);
+      report.cv_error = cv_error<Pose>(
+          poses, times, options.folds,
+          [&report](const std::vector<Pose>& train, const std::vector<double>& train_times) {
+            return fit_model<group>(report.model, train, train_times);
+          },
+          residual<group>);
     if (!best || report.criterion < *best) best = report.criterion;
   }
   if (!best) {
@@ -585,21 +601,7 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
     residuals.push_back(r);
     selection.candidates.push_back(report);
   }
-  // The floor's reference: the static model's S, or the spread about the
-  // middle observation if the mean failed.
-  std::vector<Tangent> spread = residuals.front();
-  if (spread.empty()) {
-    for (std::size_t i = 0; i < n; ++i)
-      spread.push_back(G::log(G::compose(G::inverse(observations[n / 2]), observations[i])));
-  }
-  const auto spread_covariance = detail::residual_covariance(spread);
-  const double largest_spread =
-      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
-          spread_covariance, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-  const double floor =
-      std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
+  const double floor = detail::determinant_floor<G>(residuals.front(), observations);
   std::optional<double> best;
   for (std::size_t c = 0; c < selection.candidates.size(); ++c) {
     TrendCandidate& report = selection.candidates[c];
@@ -611,27 +613,13 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
     report.log_det = detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
     report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
     if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
-      const std::vector<int> fold = detail::fold_of(times, options.folds);
-      double held_out = 0;
-      for (int k = 0; k < options.folds; ++k) {
-        std::vector<typename G::Element> train;
-        std::vector<double> train_times;
-        for (std::size_t i = 0; i < n; ++i) {
-          if (fold[i] == k) continue;
-          train.push_back(observations[i]);
-          train_times.push_back(times[i]);
-        }
-        const auto fold_fit = detail::fit_trend_model<G>(report.model, train, train_times);
-        if (!fold_fit) {
-          held_out = -1;  // a failed fold: no CV error
-          break;
-        }
-        for (std::size_t i = 0; i < n; ++i)
-          if (fold[i] == k)
-            held_out +=
-                detail::trend_residual<G>(*fold_fit, observations[i], times[i]).squaredNorm();
-      }
-      if (held_out >= 0) report.cv_error = held_out / n_real;
+      using Element = typename G::Element;
+      report.cv_error = detail::cv_error<Element>(
+          observations, times, options.folds,
+          [&report](const std::vector<Element>& train, const std::vector<double>& train_times) {
+            return detail::fit_trend_model<G>(report.model, train, train_times);
+          },
+          detail::trend_residual<G>);
     }
     if (!best || report.criterion < *best) best = report.criterion;
   }
