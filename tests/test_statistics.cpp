@@ -12,6 +12,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "bireg/groups/rn.hpp"
@@ -547,6 +549,41 @@ TEST_CASE("covariances that cannot be estimated are refused with a message, neve
     CHECK(test.message.find("permutations") != std::string::npos);
     CHECK(test.p_value == 1);
   }
+}
+
+TEST_CASE("the covariance stays positive semi-definite when the sandwich's bread is huge",
+          "[statistics][hostile]") {
+  // A fuzzer's EuRoC input: three poses, the first 9.1e15 m from the other
+  // two, which lie 5 ms apart 1.4e9 s later. K^{-1} D then has entries near
+  // 1e19 that cancel; bread * meat * bread^T came out with an eigenvalue of
+  // -5% of the largest. Formed as the Gram matrix (bread R)(bread R)^T,
+  // meat = R R^T, its eigenvalues are >= -gamma_12 * 12 * lambda_max
+  // (about 2e-14 lambda_max): 1e-12 leaves a margin of 50.
+  using G = bireg::SE3d;
+  const auto pose = [](double x, double y, double z, double qw, double qx, double qy, double qz) {
+    Eigen::Matrix4d g = Eigen::Matrix4d::Identity();
+    g.topLeftCorner<3, 3>() = Eigen::Quaterniond(qw, qx, qy, qz).normalized().toRotationMatrix();
+    g.topRightCorner<3, 1>() = Eigen::Vector3d(x, y, z);
+    return g;
+  };
+  const std::vector<Eigen::Matrix4d> poses = {
+      pose(9124868548934227, -0.06850753331747607, 0.3150191124732355, 0.9455427467358475,
+           0.20792539390782702, -0.07567889778781337, 0.23872295468413973),
+      pose(1.1746243795998712, -0.10889464389080061, 0.31359871122050165, 0.9462293090021733,
+           0.21986772857801867, -0.022656211382351635, 0.23620959506550668),
+      pose(1.2109982056753175, -0.1347974620049659, 0.30588515418110673, 0.9319344973553353,
+           0.2793734139399386, -0.0036421902114731263, 0.2311608156091031)};
+  const std::vector<double> t = {0, 1403496216.1155787, 1403496216.1205785};
+  const auto fit = bireg::GeodesicRegression<G>().fit(poses, t);
+  REQUIRE(fit.ok());
+  const auto c = bireg::covariance(fit, t);
+  REQUIRE(c.defined());
+  REQUIRE(c.endpoints.allFinite());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> eigen(c.endpoints,
+                                                                           Eigen::EigenvaluesOnly);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  CHECK(largest > 0);
+  CHECK(eigen.eigenvalues().minCoeff() >= -1e-12 * largest);
 }
 
 TEST_CASE("planar SE(3) data: pseudo-determinants, said so", "[statistics][trend]") {
