@@ -536,6 +536,21 @@ TEST_CASE("covariances that cannot be estimated are refused with a message, neve
   CHECK(c_clean.status == bireg::CovarianceStatus::undefined);
   CHECK(c_clean.message.find("residuals vanish") != std::string::npos);
   CHECK(all_finite_zero(c_clean));
+  // Robust flavour, a quantity every observation of which fits exactly:
+  // two identical observations at t = 0 pin the start (zero residuals and
+  // zero robust covariance); the homoscedastic flavour pools the residuals
+  // at t = 1 and stays defined.
+  const std::vector<Eigen::Matrix3d> pinned = {G::identity(), G::exp(x), G::identity(),
+                                               G::exp(1.001 * x)};
+  const std::vector<double> t_pinned = {0, 1, 0, 1};
+  const auto fit_pinned = regression.fit(pinned, t_pinned);
+  REQUIRE(fit_pinned.ok());
+  CHECK(bireg::covariance(fit_pinned, t_pinned).defined());
+  const auto c_pinned =
+      bireg::covariance(fit_pinned, t_pinned, {}, bireg::CovarianceFlavour::robust);
+  CHECK(c_pinned.status == bireg::CovarianceStatus::undefined);
+  CHECK(c_pinned.message.find("robust covariance of the start is zero") != std::string::npos);
+  CHECK(all_finite_zero(c_pinned));
   // A failed fit, and covariates that are not the fit's.
   bireg::RegressionResult<G> failed;
   CHECK(bireg::covariance(failed, t).status == bireg::CovarianceStatus::invalid_input);

@@ -391,6 +391,21 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
         Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces, meat);
     result.effective.velocity = covariance_detail::satterthwaite(
         Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces, meat);
+    // Zero degrees of freedom: the quantity's robust covariance is zero,
+    // every observation that bears on it fitting exactly (two identical
+    // observations at t_min pin the start, whatever the others do).
+    const std::pair<const char*, Scalar> quantities[] = {{"endpoints", result.effective.endpoints},
+                                                         {"start", result.effective.start},
+                                                         {"end", result.effective.end},
+                                                         {"velocity", result.effective.velocity}};
+    for (const auto& [name, quantity_nu] : quantities) {
+      if (!(quantity_nu > 0)) {
+        return refused<G>(CovarianceStatus::undefined,
+                          std::string("the robust covariance of the ") + name +
+                              " is zero: every observation that bears on it has a zero "
+                              "residual (the homoscedastic flavour pools the residuals)");
+      }
+    }
   }
   result.status = CovarianceStatus::defined;
   result.flavour = flavour;
