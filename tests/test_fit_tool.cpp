@@ -680,6 +680,18 @@ TEST_CASE("bireg_fit: --project re-orthonormalises and reports the correction", 
   REQUIRE(run.exit_code == 0);
   REQUIRE(std::abs(json_numbers(run.out, "projection_correction").at(0) - 0.02) < 1e-12);
   REQUIRE_FALSE(json_has_non_finite(run.out));
+  // --group auto reads rotations through SE(3) and reports the same (12
+  // poses: enough for every candidate).
+  const std::string longer = scratch("project_auto.tum");
+  std::string text = "0 0 0 0 0 0 0 1.02\n";
+  for (int i = 1; i < 12; ++i)
+    text += std::to_string(i) + " " + std::to_string(i) + " 0 0 0 0 0 1\n";
+  write_text(longer, text);
+  run = run_tool("--group auto --project " + quoted(longer));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.out.find("\"pose_group\": \"SE3\"") != std::string::npos);
+  REQUIRE(std::abs(json_numbers(run.out, "projection_correction").at(0) - 0.02) < 1e-12);
   write_text(zero, "0 0 0 0 0 0 0 0\n1 1 0 0 0 0 0 1\n");
   run = run_tool("--group SE3 --project " + quoted(zero));
   REQUIRE(run.exit_code == 2);

@@ -133,8 +133,7 @@ std::optional<std::string> output_format_problem(std::optional<bireg::io::Format
                                                  bireg::io::Format input) {
   const bireg::io::Format format = requested.value_or(input);
   if (bireg::io::supports<G>(format)) return std::nullopt;
-  return std::string("the ") + bireg::io::to_string(format) +
-         " format holds SE3 or SO3 poses, not " + G::name +
+  return bireg::io::unsupported_format_message<G>(format) +
          (requested ? "" : " (the input's format; use --output-format matrix)");
 }
 

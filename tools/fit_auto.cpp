@@ -91,13 +91,7 @@ int run_auto(const AutoCommand& command) {
   if (command.input.project) {
     io::Trajectory<bireg::SE3d> rigid;
     error = read_input<bireg::SE3d>(command.input, rigid);
-    trajectory.observations = std::move(rigid.observations);
-    trajectory.covariates = std::move(rigid.covariates);
-    trajectory.timestamps = std::move(rigid.timestamps);
-    trajectory.lines = std::move(rigid.lines);
-    trajectory.format = rigid.format;
-    trajectory.origin = rigid.origin;
-    trajectory.last = rigid.last;
+    trajectory = io::rebind_trajectory<bireg::Sim3d>(std::move(rigid));
   } else {
     error = read_input<bireg::Sim3d>(command.input, trajectory);
   }
@@ -152,11 +146,15 @@ int run_auto(const AutoCommand& command) {
   std::string table;
   for (const bireg::CandidateReport& c : selection.candidates)
     table += (table.empty() ? "\n  " : ",\n  ") + candidate_json(c, group);
+  const std::string projection =
+      command.input.project
+          ? ", \"projection_correction\": " + io::json_number(trajectory.projection_correction)
+          : std::string();
   std::printf(
-      "{\"group\": \"auto\", \"format\": \"%s\", \"pose_group\": \"%s\", \"n\": %zu,\n "
+      "{\"group\": \"auto\", \"format\": \"%s\", \"pose_group\": \"%s\", \"n\": %zu%s,\n "
       "\"recommended\": %s, ",
       io::to_string(trajectory.format), similarities ? "Sim3" : "SE3",
-      trajectory.observations.size(),
+      trajectory.observations.size(), projection.c_str(),
       selection.recommended ? json_string(bireg::to_string(*selection.recommended)).c_str()
                             : "null");
   std::printf(

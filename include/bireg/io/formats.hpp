@@ -107,6 +107,12 @@ template <class G>
 constexpr bool reads(Format format) {
   return supports<G>(format) || std::is_same_v<G, Sim3<double>>;
 }
+// Why G has no spelling in `format`: the message for !reads<G> on reading
+// and !supports<G> on writing.
+template <class G>
+std::string unsupported_format_message(Format format) {
+  return std::string("the ") + to_string(format) + " format holds SE3 or SO3 poses, not " + G::name;
+}
 // Whether ReadOptions::project applies to G.
 template <class G>
 constexpr bool can_project() {
@@ -131,6 +137,24 @@ struct Trajectory {
   Timestamp origin, last;            // the earliest and the latest timestamp
   double projection_correction = 0;  // largest change made by projection
 };
+
+// `from` as a trajectory of another group with the same matrices (rigid
+// poses read as SE(3), seen as similarities of scale 1 in Sim(3)).
+template <class To, class From>
+Trajectory<To> rebind_trajectory(Trajectory<From>&& from) {
+  static_assert(std::is_same_v<typename To::Element, typename From::Element>,
+                "rebind_trajectory: the groups' elements are different matrices");
+  Trajectory<To> to;
+  to.observations = std::move(from.observations);
+  to.covariates = std::move(from.covariates);
+  to.timestamps = std::move(from.timestamps);
+  to.lines = std::move(from.lines);
+  to.format = from.format;
+  to.origin = from.origin;
+  to.last = from.last;
+  to.projection_correction = from.projection_correction;
+  return to;
+}
 
 // Side of the square matrix of G's elements in the matrix format.
 template <class G>
@@ -338,8 +362,7 @@ std::optional<ParseError> read_trajectory(ByteSource& source, const ReadOptions&
                                           Trajectory<G>& out) {
   out = Trajectory<G>();
   if (options.format && !reads<G>(*options.format)) {
-    return ParseError{0, std::string("the ") + to_string(*options.format) +
-                             " format holds SE3 or SO3 poses, not " + G::name};
+    return ParseError{0, unsupported_format_message<G>(*options.format)};
   }
   if (options.project && !can_project<G>()) {
     return ParseError{0, std::string("--project applies to SO2, SO3, SE2 and SE3, not ") + G::name};

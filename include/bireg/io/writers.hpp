@@ -146,8 +146,7 @@ std::optional<std::string> write_trajectory(std::FILE* file, Format format, Form
                                             const std::vector<Timestamp>& times,
                                             const std::vector<typename G::Element>& poses) {
   if (!supports<G>(format)) {
-    return std::string("the ") + to_string(format) + " format holds SE3 or SO3 poses, not " +
-           G::name + " (use the matrix format)";
+    return unsupported_format_message<G>(format) + " (use the matrix format)";
   }
   std::string buffer = header_line(format);
   const auto flush_buffer = [&]() -> bool {
@@ -177,8 +176,7 @@ template <class G>
 std::string format_trajectory(Format format, Format source, const std::vector<Timestamp>& times,
                               const std::vector<typename G::Element>& poses) {
   if (!supports<G>(format)) {
-    throw std::invalid_argument(std::string("format_trajectory: the ") + to_string(format) +
-                                " format holds SE3 or SO3 poses, not " + G::name);
+    throw std::invalid_argument("format_trajectory: " + unsupported_format_message<G>(format));
   }
   std::string out = header_line(format);
   for (std::size_t i = 0; i < poses.size(); ++i)
