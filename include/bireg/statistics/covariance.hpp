@@ -108,7 +108,9 @@ inline const char* to_string(CovarianceFlavour flavour) {
 enum class CovarianceStatus {
   defined,
   invalid_input,  // the fit failed or the covariates/weights do not match it
-  undefined,      // no degrees of freedom, zero residuals, leverage 1: message says which
+  // no degrees of freedom, zero residuals, leverage 1, or (robust) a quantity
+  // with zero covariance: the message says which
+  undefined,
 };
 
 // Degrees of freedom of the quantities' covariance estimates.
