@@ -183,6 +183,28 @@ TEST_CASE("on R^n the covariance is the OLS covariance of the line's end values"
   const auto robust = bireg::covariance(fit, data.t, {}, bireg::CovarianceFlavour::robust);
   REQUIRE(robust.defined());
   CHECK(relative_error(robust.endpoints, hc2) < 1e-12);
+
+  // Noise in a plane (the third coordinate on an exact line): S has rank 2
+  // and the meat rank 4 of 6, as on planar SE(3) data. The meat's square
+  // root must be exact on its range, where a factorisation that pivots on
+  // rounding noise is not.
+  Data<R3> planar = data;
+  for (std::size_t i = 0; i < planar.t.size(); ++i)
+    planar.f[i][2] = 0.5 - 0.3 * planar.t[i];
+  const auto planar_fit =
+      bireg::GeodesicRegression<R3>(tight_options<R3>()).fit(planar.f, planar.t);
+  REQUIRE(planar_fit.ok());
+  const Ols planar_ols = ols(planar.f, planar.t);
+  const Eigen::Matrix3d planar_s = planar_ols.error_scatter / (25 - 2);
+  Eigen::Matrix<double, 6, 6> planar_expected;
+  for (int j = 0; j < 2; ++j)
+    for (int k = 0; k < 2; ++k)
+      planar_expected.block<3, 3>(3 * j, 3 * k) = ends(j, k) * planar_s;
+  const auto planar_c = bireg::covariance(planar_fit, planar.t);
+  REQUIRE(planar_c.defined());
+  CHECK(relative_error(planar_c.endpoints, planar_expected) < 1e-12);
+  CHECK(relative_error(bireg::velocity_covariance(planar_c),
+                       Eigen::Matrix3d(o.xtx_inverse(1, 1) * planar_s)) < 1e-12);
 }
 
 TEST_CASE("the covariance does not depend on a common scale of the weights",
@@ -599,6 +621,16 @@ TEST_CASE("the covariance stays positive semi-definite when the sandwich's bread
   const double largest = eigen.eigenvalues().maxCoeff();
   CHECK(largest > 0);
   CHECK(eigen.eigenvalues().minCoeff() >= -1e-12 * largest);
+  // So are the velocity's and the poses' covariances, formed from the
+  // factor F (endpoints = F F^T) by the same argument.
+  const auto positive_semidefinite = [](const Eigen::Matrix<double, 6, 6>& m) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> e(m, Eigen::EigenvaluesOnly);
+    return e.eigenvalues().maxCoeff() > 0 &&
+           e.eigenvalues().minCoeff() >= -1e-12 * e.eigenvalues().maxCoeff();
+  };
+  CHECK(positive_semidefinite(bireg::velocity_covariance(c)));
+  for (const double at : {0.0, 7e8, 1403496216.1205785})
+    CHECK(positive_semidefinite(bireg::pose_covariance(c, at)));
 }
 
 TEST_CASE("planar SE(3) data: pseudo-determinants, said so", "[statistics][trend]") {

@@ -82,17 +82,18 @@ EndpointMap<G> pose_map(const typename G::Tangent& x, typename G::Scalar s) {
 // squared.
 template <class G>
 typename G::AdMatrix velocity_covariance(const FitCovariance<G>& c) {
-  const EndpointMap<G> map = displacement_map<G>(c.geodesic.displacement());
+  const EndpointMap<G> spread = displacement_map<G>(c.geodesic.displacement()) * c.factor;
   const typename G::Scalar range = c.geodesic.t_max() - c.geodesic.t_min();
-  return map * c.endpoints * map.transpose() / (range * range);
+  return spread * spread.transpose() / (range * range);
 }
 
 // Covariance of the fitted pose at covariate t (user units), as the
 // left-trivialised perturbation eps with gamma^(t) = gamma(t) exp(eps).
 template <class G>
 typename G::AdMatrix pose_covariance(const FitCovariance<G>& c, typename G::Scalar t) {
-  const EndpointMap<G> map = pose_map<G>(c.geodesic.displacement(), c.geodesic.normalized(t));
-  return map * c.endpoints * map.transpose();
+  const EndpointMap<G> spread =
+      pose_map<G>(c.geodesic.displacement(), c.geodesic.normalized(t)) * c.factor;
+  return spread * spread.transpose();
 }
 
 // Covariance of the prediction error of a new observation at t.

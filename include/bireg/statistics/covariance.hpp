@@ -84,7 +84,6 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -134,6 +133,10 @@ struct FitCovariance {
   CovarianceFlavour flavour = CovarianceFlavour::homoscedastic;
   // Cov of (delta0, delta1), left-trivialised at the endpoints (zero unless defined).
   EndpointMatrix endpoints = EndpointMatrix::Zero();
+  // F with endpoints = F F^T: a linear map L of the endpoints has
+  // covariance (L F)(L F)^T, positive semi-definite to rounding however
+  // large L's entries (statistics/confidence.hpp forms them so).
+  EndpointMatrix factor = EndpointMatrix::Zero();
   // The exact K at the estimate (see above).
   EndpointMatrix jacobian = EndpointMatrix::Zero();
   // S = sum w r r^T / nu: the residual (noise) covariance, both flavours.
@@ -165,31 +168,20 @@ Matrix square_root(const Matrix& s) {
   return solver.eigenvectors() * root.asDiagonal();
 }
 
-// A factor R of a symmetric positive semi-definite M (M = R R^T) by the
-// pivoted LDL^T factorisation, M = P^T L D L^T P: R = P^T L D^{1/2}, with
-// pivots that rounding made slightly negative taken as zero. Pivoting
-// keeps it stable on semi-definite M, and it costs a fraction of the
-// eigendecomposition that square_root needs.
-template <class Matrix>
-Matrix semidefinite_factor(const Matrix& m) {
-  using Scalar = typename Matrix::Scalar;
-  const Eigen::LDLT<Matrix> ldlt(m);
-  Matrix factor = ldlt.matrixL();
-  factor = factor * ldlt.vectorD().cwiseMax(Scalar(0)).cwiseSqrt().asDiagonal();
-  return ldlt.transpositionsP().transpose() * factor;
-}
-
 // nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = map
 // force_i, C = sum z z^T = map (sum force force^T) map^T (on C's numerical
-// range: p its rank). `meat` is sum force force^T, so C costs no pass.
-template <class Map, class Force, class Meat>
+// range: p its rank). `meat_root` is R with R R^T = sum force force^T, so C
+// costs no pass, and C = (map R)(map R)^T is positive semi-definite to
+// rounding relative to its own largest eigenvalue, which its rank needs.
+template <class Map, class Force, class Root>
 typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& forces,
-                                   const Meat& meat) {
+                                   const Root& meat_root) {
   using Scalar = typename Map::Scalar;
   constexpr int p = Map::RowsAtCompileTime;
   using Matrix = Eigen::Matrix<Scalar, p, p>;
   using Vector = Eigen::Matrix<Scalar, p, 1>;
-  const Matrix c = map * meat * map.transpose();
+  const Map spread = map * meat_root;
+  const Matrix c = spread * spread.transpose();
   const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
   const Vector values = solver.eigenvalues();
   const Scalar largest = values[p - 1];
@@ -364,13 +356,16 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
     return refused<G>(CovarianceStatus::undefined, "K is singular at the estimate");
   }
   const EndpointMatrix bread = k_lu.solve(outer);
-  // Cov = (bread R)(bread R)^T with meat = R R^T. A Gram matrix is positive
-  // semi-definite up to rounding relative to its own largest eigenvalue;
-  // bread meat bread^T is not when bread's entries are large and cancel
-  // (a fuzzer found an eigenvalue of -5% of the largest on an SE(3) fit of
-  // poses 1e16 m apart).
-  const EndpointMatrix spread = bread * covariance_detail::semidefinite_factor(meat);
-  EndpointMatrix c = spread * spread.transpose();
+  // Cov = F F^T, F = bread R, meat = R R^T (R from meat's eigenvectors:
+  // rank-deficient meats, planar SE(3) data or small N, are the rule, and
+  // pivoted LDL^T's noise pivots would blow up there). A Gram matrix is
+  // positive semi-definite up to rounding relative to its own largest
+  // eigenvalue; bread meat bread^T is not when bread's entries are large
+  // and cancel (a fuzzer found an eigenvalue of -5% of the largest on an
+  // SE(3) fit of poses 1e16 m apart).
+  const EndpointMatrix meat_root = covariance_detail::square_root(meat);
+  const EndpointMatrix factor = bread * meat_root;
+  EndpointMatrix c = factor * factor.transpose();
   c = ((c + c.transpose()) / 2).eval();
   if (!c.allFinite()) {
     return refused<G>(CovarianceStatus::undefined, "the covariance is not finite");
@@ -386,13 +381,13 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
     velocity_map.template leftCols<d>() = -right_jacobian_inverse<G>(Tangent(-x));
     velocity_map.template rightCols<d>() = right_jacobian_inverse<G>(x);
     result.effective.endpoints =
-        covariance_detail::satterthwaite(EndpointMatrix(bread), forces, meat);
+        covariance_detail::satterthwaite(EndpointMatrix(bread), forces, meat_root);
     result.effective.start = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces, meat);
+        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces, meat_root);
     result.effective.end = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces, meat);
+        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces, meat_root);
     result.effective.velocity = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces, meat);
+        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces, meat_root);
     // Zero degrees of freedom: the quantity's robust covariance is zero,
     // every observation that bears on it fitting exactly (two identical
     // observations at t_min pin the start, whatever the others do).
@@ -412,6 +407,7 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
   result.status = CovarianceStatus::defined;
   result.flavour = flavour;
   result.endpoints = c;
+  result.factor = factor;
   result.jacobian = k;
   result.residual = s;
   result.degrees_of_freedom = nu;
