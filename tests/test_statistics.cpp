@@ -185,9 +185,8 @@ TEST_CASE("on R^n the covariance is the OLS covariance of the line's end values"
   CHECK(relative_error(robust.endpoints, hc2) < 1e-12);
 
   // Noise in a plane (the third coordinate on an exact line): S has rank 2
-  // and the meat rank 4 of 6, as on planar SE(3) data. The meat's square
-  // root must be exact on its range, where a factorisation that pivots on
-  // rounding noise is not.
+  // and the meat rank 4 of 6, as on planar SE(3) data: the meat's square
+  // root (endpoints = F F^T) must be exact on its range.
   Data<R3> planar = data;
   for (std::size_t i = 0; i < planar.t.size(); ++i)
     planar.f[i][2] = 0.5 - 0.3 * planar.t[i];
