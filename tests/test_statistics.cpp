@@ -151,10 +151,15 @@ TEST_CASE("on R^n the covariance is the OLS covariance of the line's end values"
   l << 1, t_min, 1, t_max;
   const Eigen::Matrix2d ends = l * o.xtx_inverse * l.transpose();
   const Eigen::Matrix3d s = o.error_scatter / (25 - 2);
-  Eigen::Matrix<double, 6, 6> expected;
-  for (int j = 0; j < 2; ++j)
-    for (int k = 0; k < 2; ++k)
-      expected.block<3, 3>(3 * j, 3 * k) = ends(j, k) * s;
+  // The OLS covariance of the end values, ends kron S.
+  const auto ols_covariance = [&ends](const Eigen::Matrix3d& noise) {
+    Eigen::Matrix<double, 6, 6> c;
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k)
+        c.block<3, 3>(3 * j, 3 * k) = ends(j, k) * noise;
+    return c;
+  };
+  const Eigen::Matrix<double, 6, 6> expected = ols_covariance(s);
 
   const auto homoscedastic = bireg::covariance(fit, data.t);
   REQUIRE(homoscedastic.defined());
@@ -195,13 +200,9 @@ TEST_CASE("on R^n the covariance is the OLS covariance of the line's end values"
   REQUIRE(planar_fit.ok());
   const Ols planar_ols = ols(planar.f, planar.t);
   const Eigen::Matrix3d planar_s = planar_ols.error_scatter / (25 - 2);
-  Eigen::Matrix<double, 6, 6> planar_expected;
-  for (int j = 0; j < 2; ++j)
-    for (int k = 0; k < 2; ++k)
-      planar_expected.block<3, 3>(3 * j, 3 * k) = ends(j, k) * planar_s;
   const auto planar_c = bireg::covariance(planar_fit, planar.t);
   REQUIRE(planar_c.defined());
-  CHECK(relative_error(planar_c.endpoints, planar_expected) < 1e-12);
+  CHECK(relative_error(planar_c.endpoints, ols_covariance(planar_s)) < 1e-12);
   CHECK(relative_error(bireg::velocity_covariance(planar_c),
                        Eigen::Matrix3d(o.xtx_inverse(1, 1) * planar_s)) < 1e-12);
 }
