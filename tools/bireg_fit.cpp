@@ -400,9 +400,7 @@ int run(const Command& command) {
   }
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
   const std::string projection =
-      command.input.project
-          ? ", \"projection_correction\": " + json_number(trajectory.projection_correction)
-          : std::string();
+      bireg_cli::projection_json(command.input.project, trajectory.projection_correction);
   std::printf(
       "{\"group\": \"%s\", \"format\": \"%s\", \"n\": %zu%s,\n \"g0\": %s,\n \"g1\": %s,\n"
       " \"t_min\": %s, \"t_max\": %s,\n"

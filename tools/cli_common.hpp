@@ -124,6 +124,13 @@ std::optional<std::string> read_input(const InputOptions& input,
   return std::nullopt;
 }
 
+// The JSON member that --project adds to a tool's output: the largest
+// change the projection made (nothing without --project).
+inline std::string projection_json(bool project, double correction) {
+  return project ? ", \"projection_correction\": " + bireg::io::json_number(correction)
+                 : std::string();
+}
+
 // Why the output trajectory of G cannot be written in `requested` (or, if
 // none, in the input's `input` format): a similarity read from a pose file
 // (Sim3 reads them as scale 1) has no TUM, EuRoC or KITTI spelling. Checked

@@ -147,9 +147,7 @@ int run_auto(const AutoCommand& command) {
   for (const bireg::CandidateReport& c : selection.candidates)
     table += (table.empty() ? "\n  " : ",\n  ") + candidate_json(c, group);
   const std::string projection =
-      command.input.project
-          ? ", \"projection_correction\": " + io::json_number(trajectory.projection_correction)
-          : std::string();
+      projection_json(command.input.project, trajectory.projection_correction);
   std::printf(
       "{\"group\": \"auto\", \"format\": \"%s\", \"pose_group\": \"%s\", \"n\": %zu%s,\n "
       "\"recommended\": %s, ",
