@@ -196,6 +196,72 @@ TEST_CASE("The result does not depend on the queries' order") {
   }
 }
 
+// The warm queries stop on the contraction their steps show
+// (Stopping::predicted): two evaluations of the estimating equations per
+// query on smooth data, at the endpoints a certified cold fit of the same
+// window reaches. Data as bench/bench_local_regression.cpp: a smooth SO3
+// curve at 1 kHz with noise 0.01 rad per axis, Gaussian h = 2.5 samples
+// (windows of 19-20 samples, 0.019 s wide). Both fits are within about
+// the tolerance, 1e-10, of the window's estimator: endpoints within
+// 2e-10 of each other, so poses within 4e-10 (twice that, for rounding)
+// and velocities (the endpoints' difference over the window's width)
+// within 4e-10 / 0.019 s = 2.1e-8 rad/s. The standard errors use the
+// residuals at the returned endpoints: relative agreement to 1e-6 (the
+// residuals, 0.01 rad, move by 1e-10 at most).
+TEST_CASE("Warm queries take two evaluations and reach the certified fit's endpoints") {
+  constexpr double kSpacing = 1e-3, kBandwidth = 2.5e-3;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 0.01);
+  const double omega = 2 * M_PI / 10;
+  std::vector<SO3::Element> f;
+  std::vector<double> t;
+  for (int i = 0; i < 600; ++i) {
+    const double ti = i * kSpacing;
+    const SO3::Tangent curve = 0.5 * SO3::Tangent(std::sin(omega * ti), std::cos(omega * ti) - 1,
+                                                  std::sin(2 * omega * ti));
+    const SO3::Tangent noise(normal(rng), normal(rng), normal(rng));
+    f.push_back(SO3::compose(SO3::exp(curve), SO3::exp(noise)));
+    t.push_back(ti);
+  }
+  const auto options = local_options<SO3>(bireg::Kernel::gaussian, kBandwidth);
+  const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
+  int more_than_two = 0;
+  for (std::size_t q = 0; q < estimates.size(); ++q) {
+    const auto& estimate = estimates[q];
+    REQUIRE(estimate.ok());
+    if (q > 0 && estimate.iterations > 2) ++more_than_two;
+    // The window, as the smoother forms it: support 4 h each side.
+    std::vector<SO3::Element> window_f;
+    std::vector<double> window_t, window_w;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      const double u = (t[i] - t[q]) / kBandwidth;
+      if (std::abs(u) < 4) {
+        window_f.push_back(f[i]);
+        window_t.push_back(t[i]);
+        window_w.push_back(std::exp(-u * u / 2));
+      }
+    }
+    REQUIRE(estimate.window == window_t.size());
+    bireg::RegressionOptions<double> fit_options;
+    fit_options.interval = std::make_pair(window_t.front(), window_t.back());
+    const auto fit = bireg::GeodesicRegression<SO3>(fit_options).fit(window_f, window_t, window_w);
+    REQUIRE(fit.ok());
+    CHECK(SO3::log(SO3::compose(SO3::inverse((*fit.geodesic)(t[q])), estimate.pose)).norm() <
+          4e-10);
+    CHECK((fit.geodesic->body_velocity() - estimate.velocity).norm() < 2.1e-8);
+    const auto c = bireg::covariance(fit, window_t, window_w);
+    REQUIRE(c.defined());
+    REQUIRE(estimate.velocity_error_defined);
+    const SO3::Tangent errors = bireg::standard_errors(bireg::velocity_covariance(c));
+    CHECK((errors - estimate.velocity_error).norm() < 1e-6 * errors.norm());
+  }
+  // Every warm query in two evaluations: the first step from the previous
+  // window's geodesic (about 0.01 rad, one sample entering and one
+  // leaving), the second about 1e-7, whose contraction factor ~1e-5
+  // predicts an error ~1e-12 after it.
+  CHECK(more_than_two == 0);
+}
+
 TEST_CASE("x-IMU orientation turning through more than pi is smoothed without failure") {
   std::ifstream in(BIREG_TEST_DATA_DIR "/xio_imu_orientation_slice.csv");
   REQUIRE(in);

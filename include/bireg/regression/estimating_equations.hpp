@@ -63,12 +63,16 @@ struct State {
 
 // Where the force's chunk sums run (parallel.hpp): a pool, or none for the
 // calling thread alone, and the per-chunk partial sums a pool writes,
-// sized once per fit so that no evaluation allocates.
+// sized once per fit so that no evaluation allocates; and the second
+// residual buffer the iteration evaluates trial steps into
+// (iteration.hpp), kept here so that a workspace reused across fits
+// allocates it once.
 template <class G>
 struct ForceWorkspace {
   static constexpr std::size_t kMomentsPerChunk = 2 * (kMaxSeriesOrder + 2);
   ChunkPool* pool = nullptr;
   std::vector<typename G::Tangent> partials;
+  std::vector<typename G::Tangent> trial_residuals;
 
   ForceWorkspace() = default;
   ForceWorkspace(ChunkPool* chunk_pool, std::size_t n) : pool(chunk_pool) {

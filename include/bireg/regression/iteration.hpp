@@ -1,7 +1,9 @@
 // bireg: the iteration g0 <- g0 exp(d0), g1 <- g1 exp(d1) (the paper's
 // Section 2.2 for the paper step; any step rule of solver.hpp), run until
 // the step proposed at the current endpoints is at or below the tolerance.
-// Those endpoints are returned: the step certifies them, and is not taken.
+// Those endpoints are returned: the step certifies them, and is not taken
+// (Stopping::certified, what fit() does). Stopping::predicted saves that
+// certifying evaluation where the iteration visibly contracts (below).
 //
 // Safeguard (rules with `safeguarded`): a step that would increase ||v|| is
 // halved, up to kMaxHalvings times, so a fast step cannot overshoot where
@@ -41,11 +43,32 @@ inline constexpr int kStallIterations = 10;
 // Iterations whose history is reserved up front (more grow the vectors).
 inline constexpr int kReservedHistory = 1024;
 
+// How the iteration decides it has converged.
+enum class Stopping {
+  // Return endpoints at which the proposed step is at or below the
+  // tolerance: one evaluation more than the steps taken.
+  certified,
+  // Also stop right after taking a step d_k whose contraction predicts
+  // convergence: with theta = |d_k| / |d_{k-1}| (both steps proposed at
+  // states reached by full steps), theta <= 1/2 and the a-posteriori bound
+  // of a contraction with factor theta, theta / (1 - theta) |d_k|, at or
+  // below the tolerance (measured by the rule's convergence_norm: the
+  // paper's rule judges the force, which no step bounds, so it never stops
+  // this way). The endpoints after d_k are returned without
+  // being evaluated: the returned state's x and ad_x are theirs, its force
+  // and the residuals are those of the endpoints before the step
+  // (IterationRecord::unevaluated). For a sequence of warm-started fits
+  // (the local regression), where the first step from the previous fit
+  // and one more reach the tolerance: two evaluations instead of three.
+  predicted,
+};
+
 template <class Scalar>
 struct IterationControl {
   Scalar tolerance;
   int max_iterations;
   bool record_iterates;
+  Stopping stopping = Stopping::certified;
 };
 
 // What the iteration did, for the result and its diagnostics.
@@ -56,11 +79,24 @@ struct IterationRecord {
   int backtracks = 0;  // safeguard halvings
   std::vector<typename G::Scalar> step_norms;  // every proposed step, before halving
   std::vector<std::pair<typename G::Element, typename G::Element>> iterates;  // if recorded
+  // Stopping::predicted stopped after an unevaluated step (see there).
+  bool unevaluated = false;
+
+  // To the state before any iteration, keeping the vectors' capacity.
+  void reset() {
+    status = Status::max_iterations;
+    iterations = backtracks = 0;
+    step_norms.clear();
+    iterates.clear();
+    unevaluated = false;
+  }
 };
 
 // Runs the iteration from (start0, start1), or from (fallback, fallback)
 // when that start is unusable. Returns the state at the returned endpoints,
-// whose residuals are in `residuals` (sized N). Every state it returns has
+// whose residuals are in `residuals` (sized N; see Stopping::predicted for
+// the exception). `record` is reset first, so one record (and one
+// workspace) can serve a sequence of fits without allocating again. Every state it returns has
 // a convergent series and a finite force, hence finite residuals, except
 // when even the fallback start (X = 0) is unusable, which cannot happen.
 template <class G, class Rule, class Observations>
@@ -84,14 +120,21 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
 
   const std::size_t reserved =
       static_cast<std::size_t>(std::min(control.max_iterations, kReservedHistory));
+  record.reset();
   record.step_norms.reserve(reserved);
   if (control.record_iterates) record.iterates.reserve(reserved);
-  record.status = Status::max_iterations;
   residuals.resize(observations.size());
-  std::vector<typename G::Tangent> trial_residuals(observations.size());
+  ForceWorkspace<G> local_workspace;
+  if (!workspace) workspace = &local_workspace;
+  std::vector<typename G::Tangent>& trial_residuals = workspace->trial_residuals;
+  trial_residuals.resize(observations.size());
 
   int iterations_without_progress = 0;
   Scalar smallest_step = std::numeric_limits<Scalar>::infinity();
+  // The last step's norm when it was proposed at a state reached by a
+  // full step (or the start) and taken in full: Stopping::predicted's
+  // contraction estimate needs two such steps in a row. 0: none.
+  Scalar full_step = 0;
   State<G> state = evaluate<G>(observations, problem, psi, start0, start1, residuals, workspace);
   // A start beyond the series' disc or the log's domain (an extrapolated
   // chart line on a matrix group, a far initial guess): start from the
@@ -117,6 +160,20 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
       record.status = Status::converged;
       return state;
     }
+    if (control.stopping == Stopping::predicted && full_step > 0) {
+      const Scalar theta = step_norm / full_step;
+      if (theta <= Scalar(0.5) &&
+          rule.convergence_norm(theta / (1 - theta) * step_norm, state) <= control.tolerance) {
+        state.g0 = exp_at<G>(state.g0, d0);
+        state.g1 = exp_at<G>(state.g1, d1);
+        state.x = log_at<G>(state.g0, state.g1);
+        state.a = G::ad(state.x);
+        record.status = Status::converged;
+        record.unevaluated = true;
+        if (control.record_iterates) record.iterates.emplace_back(state.g0, state.g1);
+        return state;
+      }
+    }
     // Steps below sqrt(epsilon) relative to the geodesic's size are at the
     // rounding level, where they fluctuate without meaning.
     const Scalar rounding_level = std::max(
@@ -132,6 +189,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
 
     State<G> next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, d0),
                                 exp_at<G>(state.g1, d1), trial_residuals, workspace);
+    full_step = step_norm;
     if constexpr (Rule::safeguarded) {
       const Scalar force_norm = state.force.norm();
       const auto acceptable = [&](const State<G>& trial) {
@@ -140,6 +198,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
       Scalar fraction = 1;
       for (int halving = 0; halving < kMaxHalvings && !acceptable(next); ++halving) {
         fraction /= 2;
+        full_step = 0;
         ++record.backtracks;
         next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, fraction * d0),
                            exp_at<G>(state.g1, fraction * d1), trial_residuals, workspace);

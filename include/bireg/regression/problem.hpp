@@ -63,6 +63,8 @@ bool finite(Scalar x) {
 
 // Builds the problem from n covariates and optional weights (empty: all 1)
 // and an optional interval (first < second, containing every covariate).
+// `problem` may be one built before (its vectors keep their capacity: a
+// sequence of problems no larger than the first allocates nothing).
 template <class Scalar, class Covariates>
 std::optional<Rejection> make_problem(
     const Covariates& covariates, const std::vector<Scalar>& weights,
@@ -73,16 +75,20 @@ std::optional<Rejection> make_problem(
   using Wide = CovariateScalar<Scalar>;
   const std::size_t n = covariates.size();
   const auto index = [](std::size_t i) { return static_cast<std::ptrdiff_t>(i); };
+  const auto wide = [&](std::size_t i) { return static_cast<Wide>(covariates[i]); };
   if (!weights.empty() && weights.size() != n) {
     return Rejection{"weights and observations differ in length (" +
                      std::to_string(weights.size()) + " vs " + std::to_string(n) + ")"};
   }
-  std::vector<Wide> wide(n);
+  Wide smallest = std::numeric_limits<Wide>::infinity();
+  Wide largest = -std::numeric_limits<Wide>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
-    wide[i] = static_cast<Wide>(covariates[i]);
-    if (!finite(wide[i])) {
+    const Wide covariate = wide(i);
+    if (!finite(covariate)) {
       return Rejection{"covariate " + std::to_string(i) + " is not finite", index(i)};
     }
+    smallest = std::min(smallest, covariate);
+    largest = std::max(largest, covariate);
   }
   Scalar largest_weight = 0;
   for (std::size_t i = 0; i < weights.size(); ++i) {
@@ -99,7 +105,7 @@ std::optional<Rejection> make_problem(
       return Rejection{"the covariate interval needs finite ends with first < second"};
     }
     for (std::size_t i = 0; i < n; ++i) {
-      if (wide[i] < low || wide[i] > high) {
+      if (wide(i) < low || wide(i) > high) {
         return Rejection{"covariate " + std::to_string(i) + " lies outside the covariate interval",
                          index(i)};
       }
@@ -107,9 +113,8 @@ std::optional<Rejection> make_problem(
     problem.t_min = low;
     problem.t_max = high;
   } else {
-    const auto [min_it, max_it] = std::minmax_element(wide.begin(), wide.end());
-    problem.t_min = *min_it;
-    problem.t_max = *max_it;
+    problem.t_min = smallest;
+    problem.t_max = largest;
   }
   const Wide range = problem.t_max - problem.t_min;
   if (!(range > 0) || !finite(range)) {
@@ -120,11 +125,12 @@ std::optional<Rejection> make_problem(
   problem.w.assign(n, Scalar(1));
   for (std::size_t i = 0; i < n; ++i) {
     problem.t[i] =
-        static_cast<Scalar>(std::clamp((wide[i] - problem.t_min) / range, Wide(0), Wide(1)));
+        static_cast<Scalar>(std::clamp((wide(i) - problem.t_min) / range, Wide(0), Wide(1)));
     if (!weights.empty()) problem.w[i] = weights[i] / largest_weight;
   }
 
   // H of Lemma 3.7, and its eigenvalues in a cancellation-free form.
+  problem.a = problem.b = problem.c = problem.weight_sum = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Scalar t = problem.t[i], w = problem.w[i];
     problem.a += w * (1 - t) * (1 - t);

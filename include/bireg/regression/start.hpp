@@ -50,18 +50,25 @@ struct ChartStart {
   std::ptrdiff_t too_large = -1;     // an observation whose |y_i| exceeds largest_tangent
 };
 
+// The index of the observation nearest the middle of the unit interval
+// (the first of equals): the chart's reference, and the fallback start.
+template <class Scalar>
+std::size_t middle_observation(const Problem<Scalar>& problem) {
+  using std::abs;
+  std::size_t middle = 0;
+  for (std::size_t i = 1; i < problem.size(); ++i) {
+    if (abs(problem.t[i] - Scalar(0.5)) < abs(problem.t[middle] - Scalar(0.5))) middle = i;
+  }
+  return middle;
+}
+
 template <class G, class Observations>
 ChartStart<G> chart_start(const Observations& observations,
                           const Problem<typename G::Scalar>& problem) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
   const std::size_t n = observations.size();
-  std::size_t reference = 0;
-  for (std::size_t i = 1; i < n; ++i) {
-    using std::abs;
-    if (abs(problem.t[i] - Scalar(0.5)) < abs(problem.t[reference] - Scalar(0.5))) reference = i;
-  }
-  const typename G::Element& f_ref = observations[reference];
+  const typename G::Element& f_ref = observations[middle_observation(problem)];
   const typename G::Element f_ref_inverse = G::inverse(f_ref);
   Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
   Scalar square_sum = 0;

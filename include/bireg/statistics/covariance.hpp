@@ -204,14 +204,17 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
 
 }  // namespace covariance_detail
 
-// The covariance of `fit`'s endpoints. `covariates` and `weights` must be
-// those of the fit (the interval is taken from fit.geodesic). Never throws
-// for bad input and never returns NaN: a covariance that cannot be
-// estimated is reported as undefined with a message.
-template <class G, class Covariates>
-FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& covariates,
-                            const std::vector<typename G::Scalar>& weights = {},
-                            CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
+// The covariance of the endpoints of the geodesic fitted to a problem
+// (regression/problem.hpp: the fit's covariates on its interval, and its
+// weights), from the residuals at those endpoints in the problem's order.
+// For callers that hold the problem already (the local regression, one
+// fit per window): the homoscedastic flavour allocates nothing, except the
+// message of a refusal.
+template <class G>
+FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
+                               const std::vector<typename G::Tangent>& residuals,
+                               const Problem<typename G::Scalar>& problem,
+                               CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
   static_assert(check_lie_group<G>());
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
@@ -223,24 +226,11 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
   constexpr int d = G::dof;
   using covariance_detail::refused;
   using std::sqrt;
-
-  if (!fit.ok() || !fit.geodesic) {
+  const std::size_t n = problem.size();
+  if (residuals.size() != n) {
     return refused<G>(CovarianceStatus::invalid_input,
-                      std::string("the fit did not succeed (status ") + to_string(fit.status) +
-                          "): no covariance");
-  }
-  const std::size_t n = covariates.size();
-  if (fit.residuals.size() != n) {
-    return refused<G>(CovarianceStatus::invalid_input,
-                      "the covariates are not the fit's (" + std::to_string(n) + " vs " +
-                          std::to_string(fit.residuals.size()) + " residuals)");
-  }
-  const Geodesic<G>& geodesic = *fit.geodesic;
-  Problem<Scalar> problem;
-  const std::pair<CovariateScalar<Scalar>, CovariateScalar<Scalar>> interval(geodesic.t_min(),
-                                                                             geodesic.t_max());
-  if (auto rejection = make_problem(covariates, weights, std::optional(interval), problem)) {
-    return refused<G>(CovarianceStatus::invalid_input, rejection->message);
+                      "the residuals are not the problem's (" + std::to_string(residuals.size()) +
+                          " vs " + std::to_string(n) + " covariates)");
   }
 
   // nu = W - tr(H^{-1} H_2), and the matrix H^{-1} H_2 H^{-1} of the
@@ -265,7 +255,7 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
 
   AdMatrix residual_scatter = AdMatrix::Zero();
   for (std::size_t i = 0; i < n; ++i) {
-    residual_scatter.noalias() += problem.w[i] * fit.residuals[i] * fit.residuals[i].transpose();
+    residual_scatter.noalias() += problem.w[i] * residuals[i] * residuals[i].transpose();
   }
   const AdMatrix s = residual_scatter / nu;
   if (!s.allFinite()) {
@@ -321,8 +311,8 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
       }
       const Scalar force_weight = w / sqrt(v);
       ForceVector force;
-      force.template head<d>() = (force_weight * u * start.inverse).lazyProduct(fit.residuals[i]);
-      force.template tail<d>() = (force_weight * t * end.inverse).lazyProduct(fit.residuals[i]);
+      force.template head<d>() = (force_weight * u * start.inverse).lazyProduct(residuals[i]);
+      force.template tail<d>() = (force_weight * t * end.inverse).lazyProduct(residuals[i]);
       meat_start.noalias() +=
           force.template head<d>().lazyProduct(force.template head<d>().transpose());
       meat_cross.noalias() +=
@@ -413,6 +403,37 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
   result.degrees_of_freedom = nu;
   result.geodesic = geodesic;
   return result;
+}
+
+// The covariance of `fit`'s endpoints. `covariates` and `weights` must be
+// those of the fit (the interval is taken from fit.geodesic). Never throws
+// for bad input and never returns NaN: a covariance that cannot be
+// estimated is reported as undefined with a message.
+template <class G, class Covariates>
+FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& covariates,
+                            const std::vector<typename G::Scalar>& weights = {},
+                            CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
+  using Scalar = typename G::Scalar;
+  using covariance_detail::refused;
+  if (!fit.ok() || !fit.geodesic) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      std::string("the fit did not succeed (status ") + to_string(fit.status) +
+                          "): no covariance");
+  }
+  const std::size_t n = covariates.size();
+  if (fit.residuals.size() != n) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      "the covariates are not the fit's (" + std::to_string(n) + " vs " +
+                          std::to_string(fit.residuals.size()) + " residuals)");
+  }
+  const Geodesic<G>& geodesic = *fit.geodesic;
+  Problem<Scalar> problem;
+  const std::pair<CovariateScalar<Scalar>, CovariateScalar<Scalar>> interval(geodesic.t_min(),
+                                                                             geodesic.t_max());
+  if (auto rejection = make_problem(covariates, weights, std::optional(interval), problem)) {
+    return refused<G>(CovarianceStatus::invalid_input, rejection->message);
+  }
+  return covariance_of(geodesic, fit.residuals, problem, flavour);
 }
 
 }  // namespace bireg

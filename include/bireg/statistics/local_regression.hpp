@@ -15,11 +15,16 @@
 // is that window clipped to the data there (the `interval` option), so the
 // fit's conditioning does not depend on where the window lies. Queries are
 // processed in ascending order and each fit starts from the previous
-// query's geodesic evaluated at the new window's ends (fit_from): on smooth
-// data one or two Gauss-Newton steps. The window's buffers are reused;
-// the fit itself still allocates its result's vectors (residuals, step
-// norms), O(window) per query: under 1% of the time in
-// bench/bench_local_regression.cpp.
+// query's geodesic evaluated at the new window's ends, and stops on the
+// contraction it shows (Stopping::predicted, regression/iteration.hpp): on
+// smooth data the first step, from the previous geodesic, and a second
+// one reach the tolerance, two evaluations of the estimating equations
+// per query instead of the certified stop's three. The observations and
+// the options are checked once, before any query. The window and the fit's
+// buffers are reused from query to query: once they have grown to the
+// largest window, a query allocates nothing (tests/test_allocation.cpp),
+// except the first (a cold fit), a query whose warm fit fails (refitted
+// cold, with fit()'s checks and messages) and robust queries.
 //
 // Options::robust makes every query a robust fit (statistics/robust.hpp);
 // select_bandwidth chooses h by leave-one-out cross-validation (below).
@@ -32,6 +37,7 @@
 #include <numeric>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -196,11 +202,12 @@ class LocalGeodesicRegression {
     const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
     Window window;
     window.reserve(n);
+    FitBuffers buffers;
     std::optional<Geodesic<G>> previous;
     for (const std::size_t q : query_order) {
       const Scalar tau = queries[q];
       fill_window(sorted_f, sorted_t, tau, reach, window, n);
-      estimates[q] = estimate_at(tau, window, previous);
+      estimate_at(tau, window, previous, buffers, estimates[q]);
     }
     return estimates;
   }
@@ -224,11 +231,13 @@ class LocalGeodesicRegression {
     const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
     Window window;
     window.reserve(n);
+    FitBuffers buffers;
     std::optional<Geodesic<G>> previous;
     std::vector<Tangent> errors(n);
+    Estimate estimate;
     for (std::size_t i = 0; i < n; ++i) {
       fill_window(sorted_f, sorted_t, sorted_t[i], reach, window, i);
-      const Estimate estimate = estimate_at(sorted_t[i], window, previous);
+      estimate_at(sorted_t[i], window, previous, buffers, estimate);
       if (!estimate.ok()) {
         problem =
             "observation " + std::to_string(order[i]) + " left out: " +
@@ -277,6 +286,14 @@ class LocalGeodesicRegression {
     }
   };
 
+  // The warm local fits' buffers, reused from query to query.
+  struct FitBuffers {
+    Problem<Scalar> problem;
+    std::vector<Tangent> residuals;
+    ForceWorkspace<G> workspace;
+    IterationRecord<G> record;
+  };
+
   template <class Observations, class Covariates>
   std::string check(const Observations& observations, const Covariates& covariates,
                     const std::vector<Scalar>& queries) const {
@@ -285,8 +302,12 @@ class LocalGeodesicRegression {
       return "the bandwidth must be a finite positive number";
     }
     if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
+    if (auto rejection = validate_options(options_.fit)) return rejection->message;
     if (observations.size() != covariates.size()) {
       return "observations and covariates differ in length";
+    }
+    if (auto rejection = check_observations<G>(observations, options_.fit.element_tolerance)) {
+      return rejection->message;
     }
     for (std::size_t i = 0; i < covariates.size(); ++i) {
       if (!isfinite(Scalar(covariates[i])))
@@ -316,49 +337,135 @@ class LocalGeodesicRegression {
     }
   }
 
-  Estimate estimate_at(Scalar tau, const Window& window,
-                       std::optional<Geodesic<G>>& previous) const {
-    Estimate estimate;
+  // The estimate at tau from its window, into `estimate` (whose vectors
+  // and message keep their capacity); `previous` is the last successful
+  // local geodesic, updated here.
+  void estimate_at(Scalar tau, const Window& window, std::optional<Geodesic<G>>& previous,
+                   FitBuffers& buffers, Estimate& estimate) const {
     estimate.covariate = tau;
+    estimate.status = Status::invalid_input;
+    estimate.message.clear();
+    estimate.pose = G::identity();
+    estimate.velocity.setZero();
+    estimate.velocity_error.setZero();
+    estimate.velocity_error_defined = false;
+    estimate.iterations = 0;
     estimate.window = window.covariates.size();
+    estimate.robust_status.reset();
+    estimate.robust_rounds = 0;
+    estimate.outlier_covariates.clear();
     // Ascending: distinct iff the ends differ.
     if (window.covariates.empty() || !(window.covariates.back() > window.covariates.front())) {
       estimate.message = "fewer than two distinct covariates within the kernel's support at " +
                          std::to_string(double(tau)) + " (" + std::to_string(estimate.window) +
                          " observations): widen the bandwidth";
-      return estimate;
+      return;
     }
     // The unit interval of the local fit: the window's data.
     const Scalar start_t = window.covariates.front();
     const Scalar end_t = window.covariates.back();
     RegressionOptions<Scalar> fit_options = options_.fit;
     fit_options.interval = std::make_pair(start_t, end_t);
-    if (options_.robust) return robust_estimate_at(std::move(estimate), fit_options, window);
-    const GeodesicRegression<G> regression(fit_options);
+    if (options_.robust) {
+      estimate = robust_estimate_at(std::move(estimate), fit_options, window);
+      return;
+    }
+    if (previous && warm_estimate(window, previous, buffers, estimate)) return;
     const RegressionResult<G> fit =
-        previous ? regression.fit_from({(*previous)(start_t), (*previous)(end_t)},
-                                       window.observations, window.covariates, window.weights)
-                 : regression.fit(window.observations, window.covariates, window.weights);
+        previous ? GeodesicRegression<G>(fit_options)
+                       .fit_from({(*previous)(start_t), (*previous)(end_t)}, window.observations,
+                                 window.covariates, window.weights)
+                 : GeodesicRegression<G>(fit_options)
+                       .fit(window.observations, window.covariates, window.weights);
     estimate.status = fit.status;
     estimate.message = fit.message;
-    estimate.iterations = fit.iterations;
-    if (!fit.geodesic) return estimate;
+    estimate.iterations += fit.iterations;  // after a failed warm fit's
+    if (!fit.geodesic) return;
     // A failed fit still returns its last usable endpoints: the pose and
     // velocity are reported with the failure's status, and the next query
     // does not start from them.
     const Geodesic<G>& local = *fit.geodesic;
     estimate.pose = local(tau);
     estimate.velocity = local.body_velocity();
-    if (!fit.ok()) return estimate;
+    if (!fit.ok()) return;
     previous = local;
     if (options_.standard_errors) {
-      const FitCovariance<G> c = covariance(fit, window.covariates, window.weights);
-      if (c.defined()) {
-        estimate.velocity_error = standard_errors(velocity_covariance(c));
-        estimate.velocity_error_defined = true;
-      }
+      set_velocity_error(covariance(fit, window.covariates, window.weights), estimate);
     }
-    return estimate;
+  }
+
+  // The local fit from the previous query's geodesic at the window's ends,
+  // stopping on Stopping::predicted, in the reused buffers. False, with
+  // `estimate` untouched but for its counters, when it does not succeed:
+  // the caller then refits the window with fit()'s checks and messages.
+  bool warm_estimate(const Window& window, std::optional<Geodesic<G>>& previous,
+                     FitBuffers& buffers, Estimate& estimate) const {
+    using Wide = CovariateScalar<Scalar>;
+    const Scalar start_t = window.covariates.front();
+    const Scalar end_t = window.covariates.back();
+    Problem<Scalar>& problem = buffers.problem;
+    if (make_problem(window.covariates, window.weights,
+                     std::optional(std::make_pair(Wide(start_t), Wide(end_t))), problem)) {
+      return false;
+    }
+    const RegressionOptions<Scalar>& fit_options = options_.fit;
+    return with_step_rule<G>(fit_options.solver, [&](auto tag) {
+      using Rule = typename decltype(tag)::type;
+      if (Rule::refuse(problem, fit_options.step_size)) return false;
+      const Rule rule = make_rule<Rule>(problem, *previous);
+      const PsiEvaluation psi{fit_options.method, fit_options.series_order,
+                              fit_options.max_series_order};
+      const IterationControl<Scalar> control{fit_options.tolerance, fit_options.max_iterations,
+                                             false, Stopping::predicted};
+      const State<G> state =
+          iterate<G>(window.observations, problem, psi, rule, control, (*previous)(start_t),
+                     (*previous)(end_t), window.observations[middle_observation(problem)],
+                     buffers.residuals, buffers.record, &buffers.workspace);
+      estimate.iterations = buffers.record.iterations;
+      if (!is_success(buffers.record.status)) return false;
+      const Geodesic<G> local(state.g0, state.g1, start_t, end_t);
+      estimate.status = buffers.record.status;
+      estimate.pose = local(estimate.covariate);
+      estimate.velocity = local.body_velocity();
+      previous = local;
+      if (options_.standard_errors) {
+        if (buffers.record.unevaluated) {  // the residuals are the previous endpoints'
+          const Element g0_inverse = G::inverse(state.g0);
+          for (std::size_t i = 0; i < problem.size(); ++i) {
+            buffers.residuals[i] =
+                residual<G>(g0_inverse, state.x, problem.t[i], window.observations[i]);
+          }
+        }
+        set_velocity_error(covariance_of(local, buffers.residuals, problem), estimate);
+      }
+      return true;
+    });
+  }
+
+  // The step rule of a warm fit. Gauss-Newton's K is a power series in
+  // ad_X: its terms are truncated where they fall below sqrt(epsilon) at
+  // the previous geodesic's X (math/psi_series.hpp's bound, which holds
+  // for K's coefficients too), a handful of terms on the short windows of
+  // a dense trajectory instead of kGaussNewtonOrder. K only shapes the
+  // step, so an iterate whose X outgrows that order converges a little
+  // more slowly, to the same estimate.
+  template <class Rule>
+  Rule make_rule(const Problem<Scalar>& problem, const Geodesic<G>& previous) const {
+    if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
+      using std::sqrt;
+      const Scalar tolerance = sqrt(std::numeric_limits<Scalar>::epsilon());
+      const int order =
+          adaptive_series_order(G::ad(previous.displacement()), tolerance, kGaussNewtonOrder).first;
+      return Rule(problem, options_.fit.step_size, order);
+    } else {
+      return Rule(problem, options_.fit.step_size);
+    }
+  }
+
+  static void set_velocity_error(const FitCovariance<G>& c, Estimate& estimate) {
+    if (!c.defined()) return;
+    estimate.velocity_error = standard_errors(velocity_covariance(c));
+    estimate.velocity_error_defined = true;
   }
 
   Estimate robust_estimate_at(Estimate estimate, const RegressionOptions<Scalar>& fit_options,
@@ -381,11 +488,7 @@ class LocalGeodesicRegression {
     std::vector<Scalar> combined(window.weights.size());
     for (std::size_t i = 0; i < combined.size(); ++i)
       combined[i] = window.weights[i] * robust.robust_weights[i];
-    const FitCovariance<G> c = covariance(robust.fit, window.covariates, combined);
-    if (c.defined()) {
-      estimate.velocity_error = standard_errors(velocity_covariance(c));
-      estimate.velocity_error_defined = true;
-    }
+    set_velocity_error(covariance(robust.fit, window.covariates, combined), estimate);
     return estimate;
   }
 

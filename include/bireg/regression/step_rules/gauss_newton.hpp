@@ -23,6 +23,7 @@
 // (matrix()).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <utility>
@@ -57,28 +58,34 @@ class GaussNewtonStep {
   static std::optional<Rejection> refuse(const Problem<Scalar>&, Scalar) { return std::nullopt; }
 
   // The coefficients of K's off-diagonal blocks from the mixed moments
-  // S[p][q] = sum_i w_i t_i^p u_i^q, p, q >= 1, p + q <= kOrder + 2:
+  // S[p][q] = sum_i w_i t_i^p u_i^q, p, q >= 1, p + q <= order + 2:
   // [z^m] sum_i w_i g_{t_i} = sum_k (-1)^k T[m][k] S[m-k+1][k+1]
   // (T[m][k] = b_k / (m-k+1)!), and the mirror block swaps p and q.
-  GaussNewtonStep(const Problem<Scalar>& problem, Scalar) : a_(problem.a), c_(problem.c) {
-    constexpr int kOrder = kGaussNewtonOrder;
-    constexpr int kPowers = kOrder + 2;
-    std::array<std::array<Scalar, kPowers + 1>, kPowers + 1> moments{};
-    std::array<Scalar, kPowers + 1> t_power{}, u_power{};
+  // `order` (at most kGaussNewtonOrder) truncates the series, at a cost
+  // O(N order^2) here and O(order d^3) per matrix(): a caller that knows
+  // the iterates' spectral radius stays small (the local regression's warm
+  // fits) takes fewer terms. Truncation changes K, hence the contraction
+  // factor, never the fixed point.
+  GaussNewtonStep(const Problem<Scalar>& problem, Scalar, int order = kGaussNewtonOrder)
+      : a_(problem.a), c_(problem.c), order_(std::clamp(order, 0, kGaussNewtonOrder)) {
+    constexpr int kMaxPowers = kGaussNewtonOrder + 2;
+    const int powers = order_ + 2;
+    std::array<std::array<Scalar, kMaxPowers + 1>, kMaxPowers + 1> moments{};
+    std::array<Scalar, kMaxPowers + 1> t_power{}, u_power{};
     for (std::size_t i = 0; i < problem.size(); ++i) {
       const Scalar t = problem.t[i], u = 1 - t;
       t_power[0] = problem.w[i];
       u_power[0] = 1;
-      for (int j = 1; j <= kPowers; ++j) {
+      for (int j = 1; j <= powers; ++j) {
         t_power[j] = t_power[j - 1] * t;
         u_power[j] = u_power[j - 1] * u;
       }
-      for (int p = 1; p < kPowers; ++p) {
-        for (int q = 1; p + q <= kPowers; ++q)
+      for (int p = 1; p < powers; ++p) {
+        for (int q = 1; p + q <= powers; ++q)
           moments[p][q] += t_power[p] * u_power[q];
       }
     }
-    for (int m = 0; m <= kOrder; ++m) {
+    for (int m = 0; m <= order_; ++m) {
       Scalar start = 0, end = 0;
       for (int k = 0; k <= m; ++k) {
         const Scalar coefficient = static_cast<Scalar>(kPsiSeriesTable[m][k]);
@@ -96,9 +103,9 @@ class GaussNewtonStep {
   // K at A = ad_X, the blocks by Horner's rule. Fixed-size: no allocation.
   KMatrix matrix(const AdMatrix& a) const {
     const AdMatrix identity = AdMatrix::Identity();
-    AdMatrix k01 = k01_[kGaussNewtonOrder] * identity;
-    AdMatrix k10 = k10_[kGaussNewtonOrder] * identity;
-    for (int m = kGaussNewtonOrder - 1; m >= 0; --m) {
+    AdMatrix k01 = k01_[order_] * identity;
+    AdMatrix k10 = k10_[order_] * identity;
+    for (int m = order_ - 1; m >= 0; --m) {
       k01 = a * k01 + k01_[m] * identity;
       k10 = a * k10 + k10_[m] * identity;
     }
@@ -122,6 +129,7 @@ class GaussNewtonStep {
 
  private:
   Scalar a_, c_;
+  int order_;
   std::array<Scalar, kGaussNewtonOrder + 1> k01_{}, k10_{};
 };
 
