@@ -4,13 +4,22 @@
 // Wall time (UseRealTime): the speed-up is the ratio of the /1 and /2 rows
 // of the same N within one run. Below kParallelMinimum observations (N =
 // 100) the fit stays serial whatever the thread count.
+// BM_TrendTestThreads/<threads>: the permutation test, SE(3), N = 100
+// (the same data), B = 999; BM_SmoothThreads/<threads>: the local
+// regression of bench_local_regression.cpp (SO(3), 1e5 samples at 1 kHz,
+// noise 0.01 rad, Gaussian h = 2.5 samples, no standard errors).
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/trend_test.hpp"
 
 namespace {
 
@@ -57,6 +66,42 @@ BENCHMARK(BM_Threads)
     ->ArgsProduct({{100, 10000, 100000}, {1, 2}})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
+
+void BM_TrendTestThreads(benchmark::State& state) {
+  const Data data = make_data(100);
+  const bireg::GeodesicRegression<G> regression;
+  bireg::TrendTestOptions options;
+  options.permutations = 999;
+  options.threads = static_cast<int>(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(bireg::trend_test(regression, data.f, data.t, {}, options).p_value);
+}
+BENCHMARK(BM_TrendTestThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+void BM_SmoothThreads(benchmark::State& state) {
+  using SO3 = bireg::SO3<double>;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 0.01);
+  const double w = 2 * M_PI / 10;
+  std::vector<SO3::Element> f;
+  std::vector<double> t;
+  for (int i = 0; i < 100000; ++i) {
+    const double ti = i * 1e-3;
+    const SO3::Tangent curve =
+        0.5 * SO3::Tangent(std::sin(w * ti), std::cos(w * ti) - 1, std::sin(2 * w * ti));
+    f.push_back(SO3::compose(SO3::exp(curve),
+                             SO3::exp(SO3::Tangent(normal(rng), normal(rng), normal(rng)))));
+    t.push_back(ti);
+  }
+  bireg::LocalRegressionOptions<double> options;
+  options.bandwidth = 2.5e-3;
+  options.standard_errors = false;
+  options.threads = static_cast<int>(state.range(0));
+  const bireg::LocalGeodesicRegression<SO3> smoother(options);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(smoother.smooth(f, t).data());
+}
+BENCHMARK(BM_SmoothThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -855,7 +855,8 @@ TEST_CASE("bireg_fit refuses bad --confidence, --permutations and --seed", "[too
         std::string("--confidence -0.5"), std::string("--confidence 95"),
         std::string("--permutations 0"), std::string("--permutations -10"),
         std::string("--permutations 9.5"), std::string("--seed 3"),
-        std::string("--permutations 9 --seed -1")}) {
+        std::string("--permutations 9 --seed -1"), std::string("--threads 0"),
+        std::string("--threads 2.5"), std::string("--threads 2000")}) {
     const Run run = run_tool("--group SO3 " + args + " " + file);
     CAPTURE(args, run.err);
     REQUIRE(run.exit_code == 2);
@@ -870,7 +871,8 @@ TEST_CASE("bireg_fit refuses bad --confidence, --permutations and --seed", "[too
 // The p-value is (1 + k) / (B + 1) with k an integer count: the tool and the
 // library, with the same seed, draw the same permutations, so k agrees
 // exactly (a Lambda_b tied with Lambda to rounding would be needed to flip
-// a comparison, which continuous data make improbable).
+// a comparison, which continuous data make improbable). The whole output
+// is the same on 1 and 2 threads.
 TEST_CASE("bireg_fit --permutations: the library's p-value, reproducible by seed",
           "[tool][trend]") {
   using G = bireg::SE3<double>;
@@ -878,8 +880,11 @@ TEST_CASE("bireg_fit --permutations: the library's p-value, reproducible by seed
   const std::string file = scratch("trend.csv");
   write_text(file, write_sample(sample, bireg::io::Format::matrix));
   const int b = 49;
-  const Run first = run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 " + quoted(file));
-  const Run second = run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 " + quoted(file));
+  const Run first =
+      run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 --threads 1 " + quoted(file));
+  const Run second =
+      run_tool("--group SE3 --tol 1e-14 --permutations 49 --seed 7 --threads 2 " + quoted(file));
+  REQUIRE(second.out == first.out);
   CAPTURE(first.err, first.out);
   REQUIRE(first.exit_code == 0);
   REQUIRE(second.exit_code == 0);

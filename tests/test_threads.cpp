@@ -1,14 +1,21 @@
 // Deterministic threads: the same fit with 1, 2 and 7 threads returns
 // bit-identical endpoints, residuals, step norms and diagnostics, for a
 // fit spanning several chunks (parallel.hpp) and for a small one, on both
-// evaluations of the force (closed form and series). A thread count below
-// 1 is refused with a message.
+// evaluations of the force (closed form and series). The trend test's
+// permutations and the local regression's queries (with its
+// leave-one-out errors) give identical results for 1, 2 and 7 threads. A
+// thread count below 1 is refused with a message, by each.
 #include <random>
 #include <string>
 #include <vector>
 
+#include <cmath>
+
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/trend_test.hpp"
 #include "catch.hpp"
 
 namespace {
@@ -88,4 +95,87 @@ TEST_CASE("a thread count below 1 is refused", "[threads]") {
     REQUIRE(result.status == bireg::Status::invalid_input);
     REQUIRE(result.message == "threads must be at least 1, got " + std::to_string(threads));
   }
+}
+
+// A weak trend (0.3 rad over the interval against noise 0.2 rad), so that
+// the permuted statistics straddle the observed one and a change in any
+// verdict moves the p-value.
+TEST_CASE("the trend test is identical for 1, 2 and 7 threads", "[threads]") {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> normal(0.0, 0.2);
+  std::vector<G::Element> f;
+  std::vector<double> t;
+  for (int i = 0; i < 40; ++i) {
+    G::Tangent noise;
+    for (int k = 0; k < G::dof; ++k)
+      noise[k] = normal(rng);
+    t.push_back(i / 39.0);
+    f.push_back(G::exp(t.back() * 0.3 * G::Tangent::Ones() / std::sqrt(6.0) + noise));
+  }
+  const Regression regression;
+  bireg::TrendTestOptions options;
+  options.permutations = 199;
+  options.seed = 11;
+  const auto serial = bireg::trend_test(regression, f, t, {}, options);
+  REQUIRE(serial.ok());
+  REQUIRE(serial.p_value > 0.01);  // the verdicts are mixed
+  REQUIRE(serial.p_value < 0.99);
+  for (const int threads : {2, 7}) {
+    CAPTURE(threads);
+    options.threads = threads;
+    const auto parallel = bireg::trend_test(regression, f, t, {}, options);
+    REQUIRE(parallel.ok());
+    REQUIRE(parallel.statistic == serial.statistic);
+    REQUIRE(parallel.at_least_as_extreme == serial.at_least_as_extreme);
+    REQUIRE(parallel.failed_permutations == serial.failed_permutations);
+    REQUIRE(parallel.p_value == serial.p_value);
+  }
+  options.threads = 0;
+  const auto refused = bireg::trend_test(regression, f, t, {}, options);
+  REQUIRE(refused.status == bireg::Status::invalid_input);
+  REQUIRE(refused.message == "threads must be at least 1, got 0");
+}
+
+// 2500 SO(3) samples: three blocks of queries (1024 each), so the threads
+// share them out.
+TEST_CASE("the local regression is identical for 1, 2 and 7 threads", "[threads]") {
+  using SO3 = bireg::SO3<double>;
+  std::mt19937 rng(29);
+  std::normal_distribution<double> normal(0.0, 0.01);
+  std::vector<SO3::Element> f;
+  std::vector<double> t;
+  for (int i = 0; i < 2500; ++i) {
+    const double ti = i * 1e-3;
+    const SO3::Tangent noise(normal(rng), normal(rng), normal(rng));
+    f.push_back(SO3::compose(SO3::exp(SO3::Tangent(std::sin(ti), 0.5 * ti, 0.2)), SO3::exp(noise)));
+    t.push_back(ti);
+  }
+  bireg::LocalRegressionOptions<double> options;
+  options.bandwidth = 2.5e-3;
+  const auto serial = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
+  std::string serial_problem;
+  const auto serial_errors =
+      bireg::LocalGeodesicRegression<SO3>(options).leave_one_out(f, t, serial_problem);
+  REQUIRE(serial_problem.empty());
+  for (const int threads : {2, 7}) {
+    CAPTURE(threads);
+    options.threads = threads;
+    const bireg::LocalGeodesicRegression<SO3> smoother(options);
+    const auto parallel = smoother.smooth(f, t);
+    REQUIRE(parallel.size() == serial.size());
+    for (std::size_t q = 0; q < serial.size(); ++q) {
+      REQUIRE(parallel[q].ok());
+      REQUIRE(parallel[q].pose == serial[q].pose);
+      REQUIRE(parallel[q].velocity == serial[q].velocity);
+      REQUIRE(parallel[q].velocity_error == serial[q].velocity_error);
+      REQUIRE(parallel[q].iterations == serial[q].iterations);
+    }
+    std::string problem;
+    const auto errors = smoother.leave_one_out(f, t, problem);
+    REQUIRE(problem.empty());
+    REQUIRE(errors == serial_errors);
+  }
+  options.threads = 0;
+  const auto refused = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
+  REQUIRE(refused[0].message == "threads must be at least 1, got 0");
 }

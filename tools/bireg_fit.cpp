@@ -7,7 +7,8 @@
 //             [--step LAMBDA] [--tol X] [--max-iter K]
 //             [--loss huber|cauchy|tukey [--loss-scale C]]
 //             [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]
-//             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]] FILE|-
+//             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]
+//             [--threads N] FILE|-
 //
 // The formats, their detection when --format is omitted, --times and
 // --project are described in include/bireg/io/formats.hpp and README.md.
@@ -44,6 +45,9 @@
 // data is ignored, as in the usual IRLS sandwich); the trend test permutes
 // the plain fit (the robust weights depend on the covariates, so
 // permuting them with fixed weights would not be exchangeable).
+// --threads N (default: every core) runs the permuted fits of the trend
+// test, and the force of fits of 8192 observations or more, on N threads;
+// the output does not depend on N.
 // Statistics that are undefined (N = 2, zero residuals, ...) are reported
 // in the JSON by "covariance_defined": false (or "defined": false) and a
 // "message", never by NaN or null, and give exit code 5
@@ -98,7 +102,7 @@ constexpr const char* kUsage =
     "                 [--loss huber|cauchy|tukey [--loss-scale C]]\n"
     "                 [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]\n"
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
-    "                 FILE|-\n";
+    "                 [--threads N] FILE|-\n";
 
 struct Command {
   std::string group;
@@ -117,6 +121,7 @@ struct Command {
   int permutations = 0;  // 0: no trend test
   std::optional<int> seed;
   std::string output_band;
+  int threads = bireg_cli::default_threads();
 };
 
 int fail(const std::string& message) {
@@ -218,6 +223,8 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       int seed = 0;
       if (!parse_count(*v, seed)) return "--seed needs an integer in [0, 1e9], got '" + *v + "'";
       command.seed = seed;
+    } else if (arg == "--threads") {
+      if (auto error = bireg_cli::parse_threads(*v, command.threads)) return error;
     } else if (arg == "--output-band") {
       command.output_band = *v;
     } else if (arg == "--output-trajectory") {
@@ -288,6 +295,7 @@ int statistics(const Command& command,
     bireg::TrendTestOptions test_options;
     test_options.permutations = command.permutations;
     test_options.seed = static_cast<std::uint64_t>(command.seed.value_or(0));
+    test_options.threads = command.threads;
     const auto test = bireg::trend_test(Regression(options), trajectory.observations,
                                         trajectory.covariates, {}, test_options);
     bool defined = false;
@@ -325,6 +333,7 @@ int run(const Command& command) {
   options.step_size = command.step;
   if (command.tolerance) options.tolerance = *command.tolerance;
   options.max_iterations = command.max_iterations;
+  options.threads = command.threads;
   std::optional<bireg::RobustResult<G>> robust;
   typename Regression::Result plain;
   if (command.loss) {

@@ -5,6 +5,7 @@
 // (bireg_fit, bireg_smooth) include it from tools/.
 #pragma once
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bireg/io/formats.hpp"
@@ -39,6 +41,22 @@ inline bool parse_count(const std::string& text, int& value) {
   if (!parse_number(text, x) || x != std::floor(x) || x < 0 || x > 1e9) return false;
   value = static_cast<int>(x);
   return true;
+}
+
+// --threads: the tools use every core unless told otherwise (the library's
+// own default is 1). Results do not depend on the count (the library's
+// parallel work is split independently of it).
+inline int default_threads() {
+  const unsigned cores = std::thread::hardware_concurrency();
+  return cores == 0 ? 1 : static_cast<int>(std::min(cores, 1024u));
+}
+
+// The value of --threads (an integer in [1, 1024]), or the message.
+inline std::optional<std::string> parse_threads(const std::string& text, int& threads) {
+  if (!parse_count(text, threads) || threads < 1 || threads > 1024) {
+    return "--threads needs an integer in [1, 1024], got '" + text + "'";
+  }
+  return std::nullopt;
 }
 
 // The value of --format / --output-format, or the message naming the choices.

@@ -23,7 +23,8 @@
 // the options are checked once, before any query. The window and the fit's
 // buffers are reused from query to query: once they have grown to the
 // largest window, a query allocates nothing (tests/test_allocation.cpp),
-// except the first (a cold fit), a query whose warm fit fails (refitted
+// except the first of each block of 1024 (a cold fit; the blocks are what
+// Options::threads shares out), a query whose warm fit fails (refitted
 // cold, with fit()'s checks and messages) and robust queries.
 //
 // Options::robust makes every query a robust fit (statistics/robust.hpp);
@@ -47,6 +48,7 @@
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/confidence.hpp"
 #include "bireg/statistics/covariance.hpp"
 #include "bireg/statistics/robust.hpp"
@@ -119,6 +121,11 @@ struct LocalRegressionOptions {
   // Mahalanobis distances, so the local fit stays left and right
   // equivariant.
   std::optional<RobustOptions<Scalar>> robust;
+  // Threads for the queries (>= 1; 1: the calling thread only), in blocks
+  // of 1024 queries whatever the count, so the estimates do not depend on
+  // it. The local fits themselves stay serial (`fit.threads` is not used).
+  // A std::bad_alloc on a worker terminates.
+  int threads = 1;
 };
 
 template <class G>
@@ -200,15 +207,16 @@ class LocalGeodesicRegression {
                      [&](std::size_t a, std::size_t b) { return queries[a] < queries[b]; });
 
     const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
-    Window window;
-    window.reserve(n);
-    FitBuffers buffers;
-    std::optional<Geodesic<G>> previous;
-    for (const std::size_t q : query_order) {
-      const Scalar tau = queries[q];
-      fill_window(sorted_f, sorted_t, tau, reach, window, n);
-      estimate_at(tau, window, previous, buffers, estimates[q]);
-    }
+    for_each_block(queries.size(), [&](std::size_t begin, std::size_t end) {
+      Window window;
+      FitBuffers buffers;
+      std::optional<Geodesic<G>> previous;
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::size_t q = query_order[k];
+        fill_window(sorted_f, sorted_t, queries[q], reach, window, n);
+        estimate_at(queries[q], window, previous, buffers, estimates[q]);
+      }
+    });
     return estimates;
   }
 
@@ -229,22 +237,32 @@ class LocalGeodesicRegression {
     std::vector<Element> sorted_f;
     sort_by_covariate(observations, covariates, order, sorted_t, sorted_f);
     const Scalar reach = Scalar(kernel_support(options_.kernel)) * options_.bandwidth;
-    Window window;
-    window.reserve(n);
-    FitBuffers buffers;
-    std::optional<Geodesic<G>> previous;
     std::vector<Tangent> errors(n);
-    Estimate estimate;
-    for (std::size_t i = 0; i < n; ++i) {
-      fill_window(sorted_f, sorted_t, sorted_t[i], reach, window, i);
-      estimate_at(sorted_t[i], window, previous, buffers, estimate);
-      if (!estimate.ok()) {
-        problem =
-            "observation " + std::to_string(order[i]) + " left out: " +
-            (estimate.message.empty() ? std::string(to_string(estimate.status)) : estimate.message);
-        return {};
+    // Per block, why its first failing query failed: the first block's
+    // reason that is set is the serial loop's.
+    std::vector<std::string> block_problems(block_count(n));
+    for_each_block(n, [&](std::size_t begin, std::size_t end) {
+      Window window;
+      FitBuffers buffers;
+      std::optional<Geodesic<G>> previous;
+      Estimate estimate;
+      for (std::size_t i = begin; i < end; ++i) {
+        fill_window(sorted_f, sorted_t, sorted_t[i], reach, window, i);
+        estimate_at(sorted_t[i], window, previous, buffers, estimate);
+        if (!estimate.ok()) {
+          block_problems[begin / kQueryBlock] =
+              "observation " + std::to_string(order[i]) + " left out: " +
+              (estimate.message.empty() ? std::string(to_string(estimate.status))
+                                        : estimate.message);
+          return;
+        }
+        errors[order[i]] = G::log(G::compose(G::inverse(estimate.pose), sorted_f[i]));
       }
-      errors[order[i]] = G::log(G::compose(G::inverse(estimate.pose), sorted_f[i]));
+    });
+    for (std::string& block_problem : block_problems) {
+      if (block_problem.empty()) continue;
+      problem = std::move(block_problem);
+      return {};
     }
     return errors;
   }
@@ -274,17 +292,39 @@ class LocalGeodesicRegression {
     std::vector<Element> observations;
     std::vector<Scalar> covariates;
     std::vector<Scalar> weights;
-    void reserve(std::size_t n) {
-      observations.reserve(n);
-      covariates.reserve(n);
-      weights.reserve(n);
-    }
     void clear() {
       observations.clear();
       covariates.clear();
       weights.clear();
     }
   };
+
+  // Queries run in blocks of kQueryBlock consecutive ones (in ascending
+  // covariate order), each block starting cold and warm-starting within
+  // itself. The blocks are the units of work of Options::threads and do
+  // not depend on it, so the results are bit-identical for any thread
+  // count; a cold start every 1024 queries costs nothing measurable.
+  static constexpr std::size_t kQueryBlock = 1024;
+  static std::size_t block_count(std::size_t queries) {
+    return (queries + kQueryBlock - 1) / kQueryBlock;
+  }
+
+  // Calls smooth_block(begin, end) for every block of [0, queries), on a
+  // pool when Options::threads > 1.
+  template <class Body>
+  void for_each_block(std::size_t queries, const Body& smooth_block) const {
+    const std::size_t blocks = block_count(queries);
+    const auto run = [&](std::size_t block) {
+      smooth_block(block * kQueryBlock, std::min(queries, (block + 1) * kQueryBlock));
+    };
+    if (options_.threads > 1 && blocks > 1) {
+      ChunkPool pool(options_.threads);
+      pool.run(blocks, run);
+    } else {
+      for (std::size_t block = 0; block < blocks; ++block)
+        run(block);
+    }
+  }
 
   // The warm local fits' buffers, reused from query to query.
   struct FitBuffers {
@@ -302,6 +342,8 @@ class LocalGeodesicRegression {
       return "the bandwidth must be a finite positive number";
     }
     if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
+    if (options_.threads < 1)
+      return "threads must be at least 1, got " + std::to_string(options_.threads);
     if (auto rejection = validate_options(options_.fit)) return rejection->message;
     if (observations.size() != covariates.size()) {
       return "observations and covariates differ in length";
@@ -366,6 +408,7 @@ class LocalGeodesicRegression {
     const Scalar end_t = window.covariates.back();
     RegressionOptions<Scalar> fit_options = options_.fit;
     fit_options.interval = std::make_pair(start_t, end_t);
+    fit_options.threads = 1;
     if (options_.robust) {
       estimate = robust_estimate_at(std::move(estimate), fit_options, window);
       return;

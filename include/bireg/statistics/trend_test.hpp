@@ -28,7 +28,10 @@
 //
 // Permutation b depends only on (seed, b) (statistics/permutation.hpp) and
 // each permuted fit's start depends on the permuted data only, so the
-// result is identical for any order or thread count. Each permuted fit
+// result is identical for any order or thread count. With
+// TrendTestOptions::threads > 1 the permuted fits run on a pool
+// (regression/parallel.hpp), one permutation per task, each fit serial;
+// their verdicts are counted in permutation order afterwards. Each permuted fit
 // starts from fit()'s own start (PermutationStart::chart, the default), or
 // warm from the unpermuted fit's endpoints (PermutationStart::fitted) or
 // from the mean as a constant geodesic (PermutationStart::mean, the H0
@@ -53,6 +56,7 @@
 #include <vector>
 
 #include "bireg/regression.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/mean.hpp"
 #include "bireg/statistics/permutation.hpp"
 #include "bireg/statistics/scatter.hpp"
@@ -69,6 +73,9 @@ struct TrendTestOptions {
   int permutations = 999;  // B >= 1
   std::uint64_t seed = 0;
   PermutationStart start = PermutationStart::chart;
+  // Threads for the permuted fits (>= 1; 1: the calling thread only). The
+  // result does not depend on it. A std::bad_alloc on a worker terminates.
+  int threads = 1;
 };
 
 template <class G>
@@ -107,6 +114,10 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
                      std::to_string(options.permutations);
     return result;
   }
+  if (options.threads < 1) {
+    result.message = "threads must be at least 1, got " + std::to_string(options.threads);
+    return result;
+  }
   result.fit = regression.fit(observations, covariates, weights);
   if (!result.fit.ok()) {
     result.status = result.fit.status;
@@ -142,25 +153,39 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
   // Ties (a permutation that reproduces the data's assignment) must count:
   // allow rounding-level differences between the two fits' Lambda.
   const Scalar threshold = result.statistic * (1 + Scalar(1e-10));
-  std::vector<std::size_t> order;
-  order.reserve(n);
-  std::vector<Wide> permuted(n);
-  for (int b = 0; b < options.permutations; ++b) {
+  // Each permuted fit serial: the permutations are what runs in parallel.
+  RegressionOptions<Scalar> permuted_options = regression.options();
+  permuted_options.threads = 1;
+  const GeodesicRegression<G> permuted_regression(permuted_options);
+  enum class Verdict : unsigned char { less_extreme, at_least_as_extreme, failed };
+  const std::size_t count = static_cast<std::size_t>(options.permutations);
+  std::vector<Verdict> verdicts(count);
+  const auto permuted_fit = [&](std::size_t b) {
+    std::vector<std::size_t> order;
     permutation(options.seed, static_cast<std::uint64_t>(b), n, order);
+    std::vector<Wide> permuted(n);
     for (std::size_t i = 0; i < n; ++i)
       permuted[i] = static_cast<Wide>(covariates[order[i]]);
     const RegressionResult<G> refit =
         options.start == PermutationStart::chart
-            ? regression.fit(observations, permuted, weights)
-            : regression.fit_from(start, observations, permuted, weights);
-    if (!refit.ok()) {
-      ++result.failed_permutations;
-      ++result.at_least_as_extreme;
-      continue;
-    }
-    if (range.ratio(scatter_matrix(refit.residuals, weights)) <= threshold) {
-      ++result.at_least_as_extreme;
-    }
+            ? permuted_regression.fit(observations, permuted, weights)
+            : permuted_regression.fit_from(start, observations, permuted, weights);
+    verdicts[b] = !refit.ok() ? Verdict::failed
+                  : range.ratio(scatter_matrix(refit.residuals, weights)) <= threshold
+                      ? Verdict::at_least_as_extreme
+                      : Verdict::less_extreme;
+  };
+  if (options.threads > 1) {
+    ChunkPool pool(options.threads);
+    pool.run(count, permuted_fit);
+  } else {
+    for (std::size_t b = 0; b < count; ++b)
+      permuted_fit(b);
+  }
+  for (const Verdict verdict : verdicts) {
+    if (verdict == Verdict::less_extreme) continue;
+    ++result.at_least_as_extreme;
+    if (verdict == Verdict::failed) ++result.failed_permutations;
   }
   result.permutations = options.permutations;
   result.p_value = Scalar(1 + result.at_least_as_extreme) / Scalar(1 + options.permutations);
