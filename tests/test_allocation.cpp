@@ -16,6 +16,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/local_regression.hpp"
 #include "catch.hpp"
+#include "test_support.hpp"
 
 namespace {
 std::atomic<long> allocations{0};
@@ -104,22 +105,15 @@ TEST_CASE("the threaded solver loop does not allocate", "[allocation]") {
 }
 
 // Smoothing n observations of a smooth SO(3) curve (noise 0.01 rad, 1 kHz,
-// Gaussian h = 2.5 samples), with standard errors: the buffers grow to the
+// test_support.hpp; Gaussian h = 2.5 samples), with standard errors: the buffers grow to the
 // largest window in the first queries, and no query after them allocates.
 // Allocations per call, not per query: 4x the queries, the same count.
 TEST_CASE("the local regression allocates nothing per query", "[allocation]") {
   using G = bireg::SO3<double>;
   const auto smooth_allocations = [](int n) {
-    std::mt19937 rng(7);
-    std::normal_distribution<double> normal(0.0, 0.01);
-    std::vector<G::Element> f;
-    std::vector<double> t;
-    for (int i = 0; i < n; ++i) {
-      const double ti = i * 1e-3;
-      const G::Tangent noise(normal(rng), normal(rng), normal(rng));
-      f.push_back(G::compose(G::exp(G::Tangent(std::sin(ti), 0.3 * ti, 0.1)), G::exp(noise)));
-      t.push_back(ti);
-    }
+    const bireg_test::So3Trajectory data = bireg_test::dense_so3_trajectory(n, 0.01, 7);
+    const std::vector<G::Element>& f = data.f;
+    const std::vector<double>& t = data.t;
     bireg::LocalRegressionOptions<double> options;
     options.bandwidth = 2.5e-3;
     const bireg::LocalGeodesicRegression<G> smoother(options);

@@ -209,20 +209,10 @@ TEST_CASE("The result does not depend on the queries' order") {
 // residuals at the returned endpoints: relative agreement to 1e-6 (the
 // residuals, 0.01 rad, move by 1e-10 at most).
 TEST_CASE("Warm queries take two evaluations and reach the certified fit's endpoints") {
-  constexpr double kSpacing = 1e-3, kBandwidth = 2.5e-3;
-  std::mt19937 rng(7);
-  std::normal_distribution<double> normal(0.0, 0.01);
-  const double omega = 2 * M_PI / 10;
-  std::vector<SO3::Element> f;
-  std::vector<double> t;
-  for (int i = 0; i < 600; ++i) {
-    const double ti = i * kSpacing;
-    const SO3::Tangent curve = 0.5 * SO3::Tangent(std::sin(omega * ti), std::cos(omega * ti) - 1,
-                                                  std::sin(2 * omega * ti));
-    const SO3::Tangent noise(normal(rng), normal(rng), normal(rng));
-    f.push_back(SO3::compose(SO3::exp(curve), SO3::exp(noise)));
-    t.push_back(ti);
-  }
+  constexpr double kBandwidth = 2.5e-3;
+  const bireg_test::So3Trajectory data = bireg_test::dense_so3_trajectory(600, 0.01, 7);
+  const std::vector<SO3::Element>& f = data.f;
+  const std::vector<double>& t = data.t;
   const auto options = local_options<SO3>(bireg::Kernel::gaussian, kBandwidth);
   const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
   int more_than_two = 0;

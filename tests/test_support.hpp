@@ -5,9 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "bireg/groups/so3.hpp"
 #include "bireg/testing/group_laws.hpp"
 
 namespace bireg_test {
@@ -35,6 +37,32 @@ Eigen::Matrix<long double, D, 1> random_unit(std::mt19937& rng) {
 // bireg/testing/group_laws.hpp.
 using bireg::testing::random_tangent;
 using bireg::testing::reference_expm;
+
+// A dense SO(3) trajectory, bench/bench_local_regression.cpp's: n samples
+// at 1 kHz from t = 0 of exp(0.5 (sin wt, cos wt - 1, sin 2wt)),
+// w = 2 pi / 10 s, each times exp(e), e Gaussian with standard deviation
+// `noise` per axis (std::mt19937 seeded with `seed`).
+struct So3Trajectory {
+  std::vector<bireg::SO3d::Element> f;
+  std::vector<double> t;
+};
+
+inline So3Trajectory dense_so3_trajectory(int n, double noise, unsigned seed) {
+  using SO3 = bireg::SO3d;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(0.0, noise);
+  const double omega = 2 * M_PI / 10;
+  So3Trajectory data;
+  for (int i = 0; i < n; ++i) {
+    const double t = i * 1e-3;
+    const SO3::Tangent curve =
+        0.5 * SO3::Tangent(std::sin(omega * t), std::cos(omega * t) - 1, std::sin(2 * omega * t));
+    const SO3::Tangent e(normal(rng), normal(rng), normal(rng));
+    data.f.push_back(SO3::compose(SO3::exp(curve), SO3::exp(e)));
+    data.t.push_back(t);
+  }
+  return data;
+}
 
 // Rotation matrix of the rotation vector theta * axis (unit axis), built in
 // long double from the unit quaternion (cos(theta/2), sin(theta/2) axis):

@@ -17,6 +17,7 @@
 #include "bireg/statistics/local_regression.hpp"
 #include "bireg/statistics/trend_test.hpp"
 #include "catch.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -136,20 +137,13 @@ TEST_CASE("the trend test is identical for 1, 2 and 7 threads", "[threads]") {
   REQUIRE(refused.message == "threads must be at least 1, got 0");
 }
 
-// 2500 SO(3) samples: three blocks of queries (1024 each), so the threads
+// 2500 SO(3) samples (test_support.hpp): three blocks of queries (1024 each), so the threads
 // share them out.
 TEST_CASE("the local regression is identical for 1, 2 and 7 threads", "[threads]") {
   using SO3 = bireg::SO3<double>;
-  std::mt19937 rng(29);
-  std::normal_distribution<double> normal(0.0, 0.01);
-  std::vector<SO3::Element> f;
-  std::vector<double> t;
-  for (int i = 0; i < 2500; ++i) {
-    const double ti = i * 1e-3;
-    const SO3::Tangent noise(normal(rng), normal(rng), normal(rng));
-    f.push_back(SO3::compose(SO3::exp(SO3::Tangent(std::sin(ti), 0.5 * ti, 0.2)), SO3::exp(noise)));
-    t.push_back(ti);
-  }
+  const bireg_test::So3Trajectory data = bireg_test::dense_so3_trajectory(2500, 0.01, 29);
+  const std::vector<SO3::Element>& f = data.f;
+  const std::vector<double>& t = data.t;
   bireg::LocalRegressionOptions<double> options;
   options.bandwidth = 2.5e-3;
   const auto serial = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
