@@ -297,6 +297,49 @@ TEST_CASE("on R^n the permutation p-value equals the OLS F test's with the same 
   CHECK(test.p_value < 0.9);
 }
 
+// A permuted fit stops as soon as its verdict is certain
+// (trend_detail::LambdaDecision). The verdicts must be those of permuted
+// fits run to convergence: the same count of permutations at least as
+// extreme, for null data (Lambda_b near Lambda for many b: near-ties go to
+// convergence), a weak trend (p inside (0, 1)) and a strong one (every
+// Lambda_b far above Lambda: decided early), from every start.
+TEMPLATE_TEST_CASE("early verdicts of the permuted fits are those of converged fits",
+                   "[statistics][trend]", bireg::SO3d, bireg::SE3d) {
+  using G = TestType;
+  using Tangent = typename G::Tangent;
+  std::mt19937 rng(21);
+  const bireg::GeodesicRegression<G> regression;
+  int decided = 0, permutations = 0;
+  for (const double trend : {0.0, 0.15, 2.0}) {
+    Tangent x = bireg_test::random_tangent<Tangent>(rng, 1);
+    x *= trend / x.norm();
+    const auto data = line_data<G>(random_element<G>(rng, 1), x, 40, 0.3, rng);
+    for (const auto start : {bireg::PermutationStart::chart, bireg::PermutationStart::fitted,
+                             bireg::PermutationStart::mean}) {
+      bireg::TrendTestOptions options;
+      options.permutations = 999;
+      options.seed = 8;
+      options.start = start;
+      const auto early = bireg::trend_test(regression, data.f, data.t, {}, options);
+      options.decide_early = false;
+      const auto converged = bireg::trend_test(regression, data.f, data.t, {}, options);
+      REQUIRE((early.ok() && converged.ok()));
+      CHECK(converged.decided_permutations == 0);
+      CHECK(early.at_least_as_extreme == converged.at_least_as_extreme);
+      CHECK(early.failed_permutations == converged.failed_permutations);
+      CHECK(early.p_value == converged.p_value);
+      std::printf("%s trend %.2f start %d: p = %.3f, %d of 999 decided early\n", G::name, trend,
+                  static_cast<int>(start), early.p_value, early.decided_permutations);
+      decided += early.decided_permutations;
+      permutations += options.permutations;
+      if (trend == 2.0) CHECK(early.p_value == 1.0 / 1000);  // 7 noise sd per coordinate
+    }
+  }
+  // The decision is what makes permutations cheaper than fits: most of
+  // them must end early.
+  CHECK(decided > permutations / 2);
+}
+
 TEST_CASE("permutations depend only on (seed, b) and are uniform", "[statistics][trend]") {
   std::vector<std::size_t> a, b;
   bireg::permutation(7, 3, 10, a);

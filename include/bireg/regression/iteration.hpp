@@ -81,6 +81,9 @@ struct IterationRecord {
   std::vector<std::pair<typename G::Element, typename G::Element>> iterates;  // if recorded
   // Stopping::predicted stopped after an unevaluated step (see there).
   bool unevaluated = false;
+  // The caller's Decision stopped the iteration before it converged (see
+  // iterate): `status` is then meaningless, the fit is unfinished.
+  bool decided = false;
 
   // To the state before any iteration, keeping the vectors' capacity.
   void reset() {
@@ -88,24 +91,41 @@ struct IterationRecord {
     iterations = backtracks = 0;
     step_norms.clear();
     iterates.clear();
-    unevaluated = false;
+    unevaluated = decided = false;
+  }
+};
+
+// A caller that needs a decision about the fit rather than the fit (the
+// trend test: is the permuted statistic beyond the observed one?) passes a
+// Decision to iterate: decided(residuals, theta) is called at every
+// evaluated state that has not converged, with that state's residuals and
+// theta = |d_k| / |d_{k-1}|, the contraction factor estimated from the
+// step proposed there and the full step that reached it (0 where unknown:
+// at the start, after a halved step). Returning true stops the iteration
+// there (IterationRecord::decided). NoDecision never stops it.
+struct NoDecision {
+  template <class Residuals, class Scalar>
+  bool operator()(const Residuals&, Scalar) const {
+    return false;
   }
 };
 
 // Runs the iteration from (start0, start1), or from (fallback, fallback)
-// when that start is unusable. Returns the state at the returned endpoints,
+// when that start is unusable, until it converges, fails, or `decided`
+// stops it (Decision above). Returns the state at the returned endpoints,
 // whose residuals are in `residuals` (sized N; see Stopping::predicted for
 // the exception). `record` is reset first, so one record (and one
 // workspace) can serve a sequence of fits without allocating again. Every state it returns has
 // a convergent series and a finite force, hence finite residuals, except
 // when even the fallback start (X = 0) is unusable, which cannot happen.
-template <class G, class Rule, class Observations>
+template <class G, class Rule, class Observations, class Decision = NoDecision>
 State<G> iterate(const Observations& observations, const Problem<typename G::Scalar>& problem,
                  const PsiEvaluation& psi, const Rule& rule,
                  const IterationControl<typename G::Scalar>& control,
                  const typename G::Element& start0, const typename G::Element& start1,
                  const typename G::Element& fallback, std::vector<typename G::Tangent>& residuals,
-                 IterationRecord<G>& record, ForceWorkspace<G>* workspace = nullptr) {
+                 IterationRecord<G>& record, ForceWorkspace<G>* workspace = nullptr,
+                 Decision&& decided = {}) {
   using Scalar = typename G::Scalar;
   using std::isfinite;
   using std::sqrt;
@@ -158,6 +178,10 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
     record.iterations = iteration + 1;
     if (rule.convergence_norm(step_norm, state) <= control.tolerance) {
       record.status = Status::converged;
+      return state;
+    }
+    if (decided(std::as_const(residuals), full_step > 0 ? step_norm / full_step : Scalar(0))) {
+      record.decided = true;
       return state;
     }
     if (control.stopping == Stopping::predicted && full_step > 0) {

@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <utility>
 
 #include "bireg/geodesic.hpp"
 #include "bireg/regression/problem.hpp"
@@ -62,6 +63,17 @@ std::size_t middle_observation(const Problem<Scalar>& problem) {
   return middle;
 }
 
+// The weighted least-squares line y_i ~ (1 - t_i) x0 + t_i x1 from its
+// moments, moment0 = sum w (1 - t) y and moment1 = sum w t y:
+// (x0, x1) = (H^{-1} kron I)(moment0, moment1).
+template <class Scalar, class Tangent>
+std::pair<Tangent, Tangent> least_squares_line(const Problem<Scalar>& problem,
+                                               const Tangent& moment0, const Tangent& moment1) {
+  const Scalar determinant = problem.determinant();
+  return {(problem.c * moment0 - problem.b * moment1) / determinant,
+          (problem.a * moment1 - problem.b * moment0) / determinant};
+}
+
 template <class G, class Observations>
 ChartStart<G> chart_start(const Observations& observations,
                           const Problem<typename G::Scalar>& problem) {
@@ -85,9 +97,7 @@ ChartStart<G> chart_start(const Observations& observations,
     moment1 += problem.w[i] * problem.t[i] * y;
     square_sum += problem.w[i] * y.squaredNorm();
   }
-  const Scalar determinant = problem.determinant();
-  const Tangent x0 = (problem.c * moment0 - problem.b * moment1) / determinant;
-  const Tangent x1 = (problem.a * moment1 - problem.b * moment0) / determinant;
+  const auto [x0, x1] = least_squares_line(problem, moment0, moment1);
   const Tangent total = moment0 + moment1;  // sum w y
   ChartStart<G> chart;
   chart.reference = f_ref;
