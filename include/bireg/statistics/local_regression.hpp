@@ -153,6 +153,23 @@ struct LocalEstimate {
   bool ok() const {
     return is_success(status) && (!robust_status || *robust_status == RobustStatus::converged);
   }
+
+  // To the values above, keeping the message's and the outliers' capacity
+  // (a query reuses its estimate without allocating).
+  void reset() {
+    covariate = 0;
+    status = Status::invalid_input;
+    message.clear();
+    pose = G::identity();
+    velocity.setZero();
+    velocity_error.setZero();
+    velocity_error_defined = false;
+    iterations = 0;
+    window = 0;
+    robust_status.reset();
+    robust_rounds = 0;
+    outlier_covariates.clear();
+  }
 };
 
 template <class G>
@@ -309,21 +326,13 @@ class LocalGeodesicRegression {
     return (queries + kQueryBlock - 1) / kQueryBlock;
   }
 
-  // Calls smooth_block(begin, end) for every block of [0, queries), on a
-  // pool when Options::threads > 1.
+  // Calls smooth_block(begin, end) for every block of [0, queries), on
+  // Options::threads threads (a pool of one runs them in order, here).
   template <class Body>
   void for_each_block(std::size_t queries, const Body& smooth_block) const {
-    const std::size_t blocks = block_count(queries);
-    const auto run = [&](std::size_t block) {
+    ChunkPool(options_.threads).run(block_count(queries), [&](std::size_t block) {
       smooth_block(block * kQueryBlock, std::min(queries, (block + 1) * kQueryBlock));
-    };
-    if (options_.threads > 1 && blocks > 1) {
-      ChunkPool pool(options_.threads);
-      pool.run(blocks, run);
-    } else {
-      for (std::size_t block = 0; block < blocks; ++block)
-        run(block);
-    }
+    });
   }
 
   // The warm local fits' buffers, reused from query to query.
@@ -384,18 +393,9 @@ class LocalGeodesicRegression {
   // local geodesic, updated here.
   void estimate_at(Scalar tau, const Window& window, std::optional<Geodesic<G>>& previous,
                    FitBuffers& buffers, Estimate& estimate) const {
+    estimate.reset();
     estimate.covariate = tau;
-    estimate.status = Status::invalid_input;
-    estimate.message.clear();
-    estimate.pose = G::identity();
-    estimate.velocity.setZero();
-    estimate.velocity_error.setZero();
-    estimate.velocity_error_defined = false;
-    estimate.iterations = 0;
     estimate.window = window.covariates.size();
-    estimate.robust_status.reset();
-    estimate.robust_rounds = 0;
-    estimate.outlier_covariates.clear();
     // Ascending: distinct iff the ends differ.
     if (window.covariates.empty() || !(window.covariates.back() > window.covariates.front())) {
       estimate.message = "fewer than two distinct covariates within the kernel's support at " +
@@ -406,6 +406,7 @@ class LocalGeodesicRegression {
     // The unit interval of the local fit: the window's data.
     const Scalar start_t = window.covariates.front();
     const Scalar end_t = window.covariates.back();
+    if (!options_.robust && previous && warm_estimate(window, previous, buffers, estimate)) return;
     RegressionOptions<Scalar> fit_options = options_.fit;
     fit_options.interval = std::make_pair(start_t, end_t);
     fit_options.threads = 1;
@@ -413,7 +414,6 @@ class LocalGeodesicRegression {
       estimate = robust_estimate_at(std::move(estimate), fit_options, window);
       return;
     }
-    if (previous && warm_estimate(window, previous, buffers, estimate)) return;
     const RegressionResult<G> fit =
         previous ? GeodesicRegression<G>(fit_options)
                        .fit_from({(*previous)(start_t), (*previous)(end_t)}, window.observations,
