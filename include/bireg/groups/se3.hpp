@@ -54,11 +54,14 @@ struct SE3 {
     const Vector3 rho = xi.template head<3>();
     const Vector3 omega = xi.template tail<3>();
     const Scalar theta = sqrt(omega.squaredNorm());
-    const Scalar b = small_angle::one_minus_cos_over_x2(theta);
+    // SO(3)'s coefficients, (1 - cos t)/t^2 shared with the translation.
+    const typename Rotation::RodriguesCoefficients rotation =
+        Rotation::rodrigues_coefficients(theta);
+    const Scalar b = rotation.one_minus_cos_over_angle2;
     const Scalar c = small_angle::x_minus_sin_over_x3(theta);
     const Vector3 w_rho = omega.cross(rho);
     Element g = Element::Identity();
-    g.template topLeftCorner<3, 3>() = Rotation::exp(omega);
+    g.template topLeftCorner<3, 3>() = Rotation::rodrigues(omega, rotation.sin_over_angle, b);
     g.template topRightCorner<3, 1>() = rho + b * w_rho + c * omega.cross(w_rho);
     return g;
   }

@@ -41,17 +41,44 @@ struct SO3 {
   static Element inverse(const Element& g) { return g.transpose(); }
 
   // R = I + (sin t / t) W + ((1 - cos t)/t^2) W^2, W = hat(omega), t = |omega|.
-  // With h = t/2: sin t / t = sinc(h) cos(h) and (1 - cos t)/t^2 = sinc(h)^2/2,
-  // so one sin/cos pair of the half angle gives both, without cancellation.
   static Element exp(const Tangent& omega) {
-    using std::cos;
     using std::sqrt;
-    const Scalar half_angle = sqrt(omega.squaredNorm()) / Scalar(2);
-    const Scalar sinc_half = small_angle::sin_over_x(half_angle);
-    const Scalar sin_over_angle = sinc_half * cos(half_angle);
-    const Scalar one_minus_cos_over_angle2 = sinc_half * sinc_half / Scalar(2);
-    const Algebra w = hat(omega);
-    return Element::Identity() + sin_over_angle * w + one_minus_cos_over_angle2 * (w * w);
+    const RodriguesCoefficients c = rodrigues_coefficients(sqrt(omega.squaredNorm()));
+    return rodrigues(omega, c.sin_over_angle, c.one_minus_cos_over_angle2);
+  }
+
+  // With h = t/2: sin t / t = sinc(h) cos(h) and (1 - cos t)/t^2 = sinc(h)^2/2,
+  // so one sin/cos pair of the half angle gives both, without cancellation
+  // (sin and cos side by side, so that the compiler makes one sincos call).
+  struct RodriguesCoefficients {
+    Scalar sin_over_angle, one_minus_cos_over_angle2;
+  };
+  static RodriguesCoefficients rodrigues_coefficients(Scalar angle) {
+    using std::cos;
+    using std::sin;
+    const Scalar half_angle = angle / Scalar(2);
+    const Scalar sin_half = sin(half_angle), cos_half = cos(half_angle);
+    const Scalar sinc_half = half_angle < small_angle::tiny_angle<Scalar>()
+                                 ? small_angle::sin_over_x(half_angle)
+                                 : sin_half / half_angle;
+    return {sinc_half * cos_half, sinc_half * sinc_half / Scalar(2)};
+  }
+
+  // I + a W + b W^2, W = hat(omega), entry by entry: W^2 = omega omega^T -
+  // |omega|^2 I, whose diagonal is -(the other two squares), so no entry is
+  // formed by cancellation and no 3 x 3 product is needed. exp's matrix for
+  // a = sin t / t, b = (1 - cos t)/t^2; SE(3)'s exp calls it with the
+  // coefficients it shares with its translation part.
+  static Element rodrigues(const Tangent& omega, Scalar a, Scalar b) {
+    const Tangent square = omega.cwiseAbs2();
+    const Scalar b01 = b * omega[0] * omega[1], b02 = b * omega[0] * omega[2],
+                 b12 = b * omega[1] * omega[2];
+    const Tangent a_omega = a * omega;
+    Element r;
+    r << Scalar(1) - b * (square[1] + square[2]), b01 - a_omega[2], b02 + a_omega[1],
+        b01 + a_omega[2], Scalar(1) - b * (square[0] + square[2]), b12 - a_omega[0],
+        b02 - a_omega[1], b12 + a_omega[0], Scalar(1) - b * (square[0] + square[1]);
+    return r;
   }
 
   // Unit quaternion (w >= 0) of a rotation matrix by Shepperd's method: the
