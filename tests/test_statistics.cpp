@@ -416,6 +416,87 @@ TEMPLATE_TEST_CASE("covariances and the trend test keep the estimator's equivari
   CHECK(e.generalized == Approx(1 - test.statistic).epsilon(1e-10));
 }
 
+// math/ad_algebra.hpp's contract on SO(3) and SE(3): the relations of
+// A = ad_X, N1 and N2, and the Jacobians, products and inverses it computes
+// from five coefficients, against the matrices. Rounding only: 1e-13
+// relative (the matrices' entries grow like theta^3; up to theta = 4.5).
+TEMPLATE_TEST_CASE("the algebra of ad_X: relations, Jacobians, products and inverses",
+                   "[statistics][covariance]", bireg::SO3d, bireg::SE3d) {
+  using G = TestType;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+  using Function = bireg::AdFunction<double>;
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  for (const double angle : {1e-4, 0.3, 1.0, 2.5, 3.1, 4.5}) {
+    Tangent x = bireg_test::random_tangent<Tangent>(rng, 1);
+    x.template tail<3>() *= angle / x.template tail<3>().norm();
+    const bireg::AdAlgebraBasis<AdMatrix> basis = G::ad_algebra_basis(x);
+    const AdMatrix a = G::ad(x);
+    const double size = 1 + a.norm() * a.norm() * a.norm();
+    CHECK((basis.a - a).norm() == 0);
+    CHECK((basis.a2 - a * a).norm() <= 1e-14 * size);
+    CHECK((a * a * a + basis.theta2 * a + 2 * basis.kappa * basis.n1).norm() <= 1e-13 * size);
+    CHECK((a * basis.n1 - basis.n2).norm() <= 1e-14 * size);
+    CHECK((basis.n1 * a - basis.n2).norm() <= 1e-14 * size);
+    CHECK((a * basis.n2 + basis.theta2 * basis.n1).norm() <= 1e-13 * size);
+    CHECK((basis.n2 * a + basis.theta2 * basis.n1).norm() <= 1e-13 * size);
+    for (const double s : {-0.7, 0.4, 1.0}) {
+      const Function inverse = basis.right_jacobian_inverse(s);
+      CHECK(relative_error(basis.matrix(inverse), G::right_jacobian_inverse(Tangent(s * x))) <
+            1e-13);
+      CHECK(relative_error(basis.matrix(basis.inverse(inverse)),
+                           G::right_jacobian(Tangent(s * x))) < 1e-13);
+    }
+    const Function f{1 + uniform(rng), uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
+    const Function g{1 + uniform(rng), uniform(rng), uniform(rng), uniform(rng), uniform(rng)};
+    const AdMatrix product = basis.matrix(f) * basis.matrix(g);
+    CHECK(relative_error(basis.matrix(basis.product(f, g)), product) < 1e-13);
+    CHECK(relative_error(basis.matrix(basis.product(f, basis.inverse(f))),
+                         AdMatrix(AdMatrix::Identity())) < 1e-12);
+  }
+}
+
+// The covariance's pass in the algebra of ad_X (the default on SO(3) and
+// SE(3)) against the pass with d x d Jacobians per observation: the same
+// sums in another order, so the same covariance to rounding (1e-12
+// relative; the robust degrees of freedom, through eigenvalues, 1e-10), for
+// short and long geodesics, weighted, both flavours.
+TEMPLATE_TEST_CASE("the covariance in the algebra of ad_X equals the matrix pass",
+                   "[statistics][covariance]", bireg::SO3d, bireg::SE3d) {
+  using G = TestType;
+  using Tangent = typename G::Tangent;
+  std::mt19937 rng(32);
+  std::uniform_real_distribution<double> uniform(0.2, 2.0);
+  for (const double angle : {0.01, 1.0, 3.0}) {
+    Tangent x = bireg_test::random_tangent<Tangent>(rng, 1);
+    x.template tail<3>() *= angle / x.template tail<3>().norm();
+    const auto data = line_data<G>(random_element<G>(rng, 1), x, 40, 0.1, rng);
+    std::vector<double> weights(data.t.size());
+    for (double& w : weights)
+      w = uniform(rng);
+    const auto fit = bireg::GeodesicRegression<G>(tight_options<G>()).fit(data.f, data.t, weights);
+    REQUIRE(fit.ok());
+    bireg::Problem<double> problem;
+    const std::pair<long double, long double> interval(fit.geodesic->t_min(),
+                                                       fit.geodesic->t_max());
+    REQUIRE(!bireg::make_problem(data.t, weights, std::optional(interval), problem));
+    for (const auto flavour :
+         {bireg::CovarianceFlavour::homoscedastic, bireg::CovarianceFlavour::robust}) {
+      const auto algebra = bireg::covariance_of(*fit.geodesic, fit.residuals, problem, flavour);
+      const auto matrices =
+          bireg::covariance_of(*fit.geodesic, fit.residuals, problem, flavour, true);
+      REQUIRE((algebra.defined() && matrices.defined()));
+      CHECK(relative_error(algebra.endpoints, matrices.endpoints) < 1e-12);
+      CHECK(relative_error(algebra.jacobian, matrices.jacobian) < 1e-12);
+      CHECK(std::abs(algebra.effective.velocity - matrices.effective.velocity) <
+            1e-10 * matrices.effective.velocity);
+      CHECK(std::abs(algebra.effective.endpoints - matrices.effective.endpoints) <
+            1e-10 * matrices.effective.endpoints);
+    }
+  }
+}
+
 TEMPLATE_TEST_CASE("the exact K matches finite differences of the force; the series K is close",
                    "[statistics][covariance]", bireg::SO3d, bireg::SE3d) {
   using G = TestType;

@@ -15,6 +15,11 @@
 //       J_r(x) and J_r(x)^{-1} together, sharing their common factors (the
 //       covariance needs both at every observation).
 //       fallback: right_jacobian(x) and right_jacobian_inverse(x).
+//   AdAlgebraBasis<AdMatrix> ad_algebra_basis(const Tangent& x)
+//       the algebra of analytic functions of ad_x in five numbers
+//       (math/ad_algebra.hpp; SO(3) and SE(3)): the covariance sums its
+//       per-observation Jacobians there. fallback: d x d matrices per
+//       observation (statistics/covariance.hpp).
 //   struct ClosedFormPsi                             psi_s(ad_x) r in closed form
 //       (see math/psi_closed_form.hpp and SO3::ClosedFormPsi for the
 //       interface) fallback: the power series of math/psi_series.hpp.
@@ -57,6 +62,8 @@ using right_jacobian_inverse =
     decltype(G::right_jacobian_inverse(std::declval<const Tangent<G>&>()));
 template <class G>
 using right_jacobian_pair = decltype(G::right_jacobian_pair(std::declval<const Tangent<G>&>()));
+template <class G>
+using ad_algebra_basis = decltype(G::ad_algebra_basis(std::declval<const Tangent<G>&>()));
 template <class G>
 using closed_form_psi = typename G::ClosedFormPsi;
 }  // namespace capability_detail

@@ -138,6 +138,24 @@ struct SE3 {
             block_triangular(rotation.inverse, coupling)};
   }
 
+  // The algebra of functions of ad_xi = [W P; 0 W] (math/ad_algebra.hpp):
+  // N1 = [0 W; 0 0], N2 = [0 W^2; 0 0], theta = |omega|, kappa = omega . rho.
+  static AdAlgebraBasis<AdMatrix> ad_algebra_basis(const Tangent& xi) {
+    using std::sqrt;
+    const Vector3 rho = xi.template head<3>(), omega = xi.template tail<3>();
+    AdAlgebraBasis<AdMatrix> basis;
+    basis.theta2 = omega.squaredNorm();
+    basis.theta = sqrt(basis.theta2);
+    basis.kappa = omega.dot(rho);
+    const Matrix3 w = Rotation::hat(omega);
+    const Matrix3 w2 = omega * omega.transpose() - basis.theta2 * Matrix3::Identity();
+    basis.a = ad(xi);
+    basis.a2 = block_triangular(w2, w * Rotation::hat(rho) + Rotation::hat(rho) * w);
+    basis.n1 = block_triangular(Matrix3::Zero(), w);
+    basis.n2 = block_triangular(Matrix3::Zero(), w2);
+    return basis;
+  }
+
   // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
   // to within tol (max-norm), all finite.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {

@@ -19,6 +19,7 @@
 
 #include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/ad_algebra.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/small_angle.hpp"
 
@@ -188,6 +189,19 @@ struct SO3 {
                 small_angle::x_minus_sin_over_x3(angle) * w2,
             AdMatrix::Identity() + w / Scalar(2) +
                 small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * w2};
+  }
+
+  // The algebra of functions of ad_omega = W (math/ad_algebra.hpp), with
+  // W^2 = omega omega^T - theta^2 I; N1 = N2 = 0 and kappa = 0 here.
+  static AdAlgebraBasis<AdMatrix> ad_algebra_basis(const Tangent& omega) {
+    using std::sqrt;
+    AdAlgebraBasis<AdMatrix> basis;
+    basis.theta2 = omega.squaredNorm();
+    basis.theta = sqrt(basis.theta2);
+    basis.a = hat(omega);
+    basis.a2 = omega * omega.transpose() - basis.theta2 * AdMatrix::Identity();
+    basis.n1 = basis.n2 = AdMatrix::Zero();
+    return basis;
   }
 
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.

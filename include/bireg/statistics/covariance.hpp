@@ -73,7 +73,14 @@
 //
 // u_i = 1 - t_i, and Psi_i = diag(J_r(-X), J_r(X)) [u_i J_r(-u_i X)^{-1};
 // t_i J_r(t_i X)^{-1}]: one pass, four d x d Jacobians per observation, the
-// constant outer factors applied once.
+// constant outer factors applied once. On SO(3) and SE(3) every one of
+// these Jacobians is a function of A = ad_X, held as five numbers in the
+// basis I, A, A^2, N1, N2 of math/ad_algebra.hpp: the sums of K's blocks
+// are sums of coefficients, and the homoscedastic meat sum_i w_i^2 Psi_i S
+// Psi_i^T is sum_{k,l} m_kl B_k S B_l^T with m_kl = sum_i of products of
+// coefficients. The pass then costs scalar arithmetic per observation and
+// d x d products only once; it is exact like the matrix form, to which a
+// test compares it.
 #pragma once
 
 #include <cmath>
@@ -90,6 +97,8 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
+#include "bireg/groups/capabilities.hpp"
+#include "bireg/math/ad_algebra.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/result.hpp"
 
@@ -202,6 +211,174 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
   return sum > 0 ? Scalar(rank * (rank + 2)) / sum : Scalar(0);
 }
 
+// The pass over the observations: K's off-diagonal cores, the meat of the
+// core Psi_i = [u J_r(-uX)^{-1}; t J_r(tX)^{-1}] by d x d blocks (the start's,
+// the cross term, the end's; the fourth is the cross term's transpose) and,
+// for the robust flavour, each observation's core force w_i Psi_i r_i /
+// sqrt(v_i).
+template <class G>
+struct ObservationSums {
+  using AdMatrix = typename G::AdMatrix;
+  using ForceVector = Eigen::Matrix<typename G::Scalar, 2 * G::dof, 1>;
+  AdMatrix k01_core = AdMatrix::Zero(), k10_core = AdMatrix::Zero();
+  AdMatrix meat_start = AdMatrix::Zero(), meat_cross = AdMatrix::Zero(),
+           meat_end = AdMatrix::Zero();
+  std::vector<ForceVector> forces;
+  std::ptrdiff_t leverage_one = -1;  // robust: an observation of leverage 1
+};
+
+// What the pass needs besides the residuals: the leverages' matrices (the
+// robust flavour's v_i) and S's square root (the homoscedastic meat).
+template <class G>
+struct PassInputs {
+  using Matrix2 = Eigen::Matrix<typename G::Scalar, 2, 2>;
+  typename G::Tangent x;
+  Matrix2 h_inverse, leverage_matrix;
+  typename G::AdMatrix s_root;
+  CovarianceFlavour flavour;
+};
+
+// v_i = 1 - 2 w l^T H^{-1} l + l^T H^{-1} H_2 H^{-1} l, l = (u, t).
+template <class G>
+typename G::Scalar hc2_factor(const PassInputs<G>& in, typename G::Scalar w, typename G::Scalar t) {
+  const Eigen::Matrix<typename G::Scalar, 2, 1> l(1 - t, t);
+  return 1 - 2 * w * l.dot(in.h_inverse * l) + l.dot(in.leverage_matrix * l);
+}
+
+// The robust flavour's force of one observation, from its Psi blocks
+// applied to r; accumulated into the meat. False at leverage 1.
+template <class G, class ApplyStart, class ApplyEnd>
+bool add_robust_force(const PassInputs<G>& in, typename G::Scalar w, typename G::Scalar t,
+                      const ApplyStart& start_inverse_times, const ApplyEnd& end_inverse_times,
+                      ObservationSums<G>& sums) {
+  using Scalar = typename G::Scalar;
+  constexpr int d = G::dof;
+  const Scalar v = hc2_factor(in, w, t);
+  if (!(v > Scalar(1e-12))) return false;
+  const Scalar force_weight = w / std::sqrt(v);
+  typename ObservationSums<G>::ForceVector force;
+  force.template head<d>() = (force_weight * (1 - t)) * start_inverse_times();
+  force.template tail<d>() = (force_weight * t) * end_inverse_times();
+  const auto head = force.template head<d>();
+  const auto tail = force.template tail<d>();
+  sums.meat_start.noalias() += head.lazyProduct(head.transpose());
+  sums.meat_cross.noalias() += head.lazyProduct(tail.transpose());
+  sums.meat_end.noalias() += tail.lazyProduct(tail.transpose());
+  sums.forces.push_back(force);
+  return true;
+}
+
+// The pass with d x d Jacobians per observation (every group).
+template <class G>
+ObservationSums<G> sums_by_matrices(const PassInputs<G>& in,
+                                    const Problem<typename G::Scalar>& problem,
+                                    const std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+  ObservationSums<G> sums;
+  if (in.flavour == CovarianceFlavour::robust) sums.forces.reserve(problem.size());
+  for (std::size_t i = 0; i < problem.size(); ++i) {
+    const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
+    if (w == 0) continue;
+    const RightJacobianPair<AdMatrix> start = right_jacobian_pair<G>(Tangent(-u * in.x));
+    const RightJacobianPair<AdMatrix> end = right_jacobian_pair<G>(Tangent(t * in.x));
+    // Small fixed-size products are written as lazy (coefficient-wise)
+    // products: Eigen's blocked kernels cost more than the arithmetic here.
+    const Scalar k_weight = w * t * u;
+    sums.k01_core.noalias() += (k_weight * start.inverse).lazyProduct(end.jacobian);
+    sums.k10_core.noalias() += (k_weight * end.inverse).lazyProduct(start.jacobian);
+    if (in.flavour == CovarianceFlavour::homoscedastic) {
+      // w Psi_i S Psi_i^T w, with S = s_root s_root^T.
+      const AdMatrix start_spread = (w * u * start.inverse).lazyProduct(in.s_root);
+      const AdMatrix end_spread = (w * t * end.inverse).lazyProduct(in.s_root);
+      sums.meat_start.noalias() += start_spread.lazyProduct(start_spread.transpose());
+      sums.meat_cross.noalias() += start_spread.lazyProduct(end_spread.transpose());
+      sums.meat_end.noalias() += end_spread.lazyProduct(end_spread.transpose());
+    } else if (!add_robust_force(
+                   in, w, t, [&] { return Tangent(start.inverse.lazyProduct(residuals[i])); },
+                   [&] { return Tangent(end.inverse.lazyProduct(residuals[i])); }, sums)) {
+      sums.leverage_one = static_cast<std::ptrdiff_t>(i);
+      return sums;
+    }
+  }
+  return sums;
+}
+
+// The same pass in the algebra of functions of ad_X (math/ad_algebra.hpp;
+// groups with ad_algebra_basis): per observation, the coefficients of
+// J_r(-uX)^{-1} and J_r(tX)^{-1}, their inverses J_r (two 2 x 2 solves),
+// and two products, all scalar. Psi's blocks have p = 0, so the
+// homoscedastic meat needs the sums of coefficient products over the
+// basis I, A, A^2, N2 only.
+template <class G>
+ObservationSums<G> sums_by_algebra(const PassInputs<G>& in,
+                                   const Problem<typename G::Scalar>& problem,
+                                   const std::vector<typename G::Tangent>& residuals) {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+  using Function = AdFunction<Scalar>;
+  using Vector4 = Eigen::Matrix<Scalar, 4, 1>;
+  using Matrix4 = Eigen::Matrix<Scalar, 4, 4>;
+  const AdAlgebraBasis<AdMatrix> basis = G::ad_algebra_basis(in.x);
+  const auto psi_coefficients = [](const Function& f, Scalar k) {
+    return Vector4(k * f.a, k * f.b, k * f.c, k * f.q);
+  };
+  ObservationSums<G> sums;
+  if (in.flavour == CovarianceFlavour::robust) sums.forces.reserve(problem.size());
+  Function k01, k10;
+  Matrix4 m_start = Matrix4::Zero(), m_cross = Matrix4::Zero(), m_end = Matrix4::Zero();
+  for (std::size_t i = 0; i < problem.size(); ++i) {
+    const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
+    if (w == 0) continue;
+    const Function start_inverse = basis.right_jacobian_inverse(-u);
+    const Function end_inverse = basis.right_jacobian_inverse(t);
+    const Scalar k_weight = w * t * u;
+    k01 += basis.product(start_inverse, basis.inverse(end_inverse)).scaled(k_weight);
+    k10 += basis.product(end_inverse, basis.inverse(start_inverse)).scaled(k_weight);
+    if (in.flavour == CovarianceFlavour::homoscedastic) {
+      const Vector4 alpha = psi_coefficients(start_inverse, w * u);
+      const Vector4 beta = psi_coefficients(end_inverse, w * t);
+      m_start.noalias() += alpha.lazyProduct(alpha.transpose());
+      m_cross.noalias() += alpha.lazyProduct(beta.transpose());
+      m_end.noalias() += beta.lazyProduct(beta.transpose());
+      continue;
+    }
+    const Tangent& r = residuals[i];
+    const Tangent a_r = basis.a.lazyProduct(r), a2_r = basis.a2.lazyProduct(r),
+                  n2_r = basis.n2.lazyProduct(r);
+    const auto times = [&](const Function& f) {
+      return Tangent(f.a * r + f.b * a_r + f.c * a2_r + f.q * n2_r);
+    };
+    if (!add_robust_force(
+            in, w, t, [&] { return times(start_inverse); }, [&] { return times(end_inverse); },
+            sums)) {
+      sums.leverage_one = static_cast<std::ptrdiff_t>(i);
+      return sums;
+    }
+  }
+  sums.k01_core = basis.matrix(k01);
+  sums.k10_core = basis.matrix(k10);
+  if (in.flavour == CovarianceFlavour::homoscedastic) {
+    // sum_{k,l} m_kl B_k S B_l^T = sum_k (B_k S) (sum_l m_kl B_l)^T.
+    const AdMatrix s = in.s_root * in.s_root.transpose();
+    const AdMatrix b[4] = {AdMatrix::Identity(), basis.a, basis.a2, basis.n2};
+    const auto meat = [&](const Matrix4& m) {
+      AdMatrix sum = AdMatrix::Zero();
+      for (int k = 0; k < 4; ++k) {
+        const AdMatrix combined = m(k, 0) * b[0] + m(k, 1) * b[1] + m(k, 2) * b[2] + m(k, 3) * b[3];
+        sum.noalias() += (b[k] * s) * combined.transpose();
+      }
+      return sum;
+    };
+    sums.meat_start = meat(m_start);
+    sums.meat_cross = meat(m_cross);
+    sums.meat_end = meat(m_end);
+  }
+  return sums;
+}
+
 }  // namespace covariance_detail
 
 // The covariance of the endpoints of the geodesic fitted to a problem
@@ -209,12 +386,15 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
 // weights), from the residuals at those endpoints in the problem's order.
 // For callers that hold the problem already (the local regression, one
 // fit per window): the homoscedastic flavour allocates nothing, except the
-// message of a refusal.
+// message of a refusal. `matrix_pass` forces the pass with d x d matrices
+// per observation where the group has the algebra of ad_X (for tests; the
+// two agree to rounding).
 template <class G>
 FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
                                const std::vector<typename G::Tangent>& residuals,
                                const Problem<typename G::Scalar>& problem,
-                               CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
+                               CovarianceFlavour flavour = CovarianceFlavour::homoscedastic,
+                               bool matrix_pass = false) {
   static_assert(check_lie_group<G>());
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
@@ -273,55 +453,27 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   }
 
   const Tangent x = geodesic.displacement();
-  const AdMatrix s_root = covariance_detail::square_root(s);
-  using ForceVector = Eigen::Matrix<Scalar, 2 * d, 1>;
-  std::vector<ForceVector> forces;  // robust: w_i Psi_i r_i / sqrt(v_i), core part
-  if (flavour == CovarianceFlavour::robust) forces.reserve(n);
-  AdMatrix k01_core = AdMatrix::Zero(), k10_core = AdMatrix::Zero();
-  // The meat of the core Psi_i = [u J_r(-uX)^{-1}; t J_r(tX)^{-1}], by 6 x 6
-  // blocks: the start's, the cross term and the end's (its transpose is the
-  // fourth).
-  AdMatrix meat_start = AdMatrix::Zero(), meat_cross = AdMatrix::Zero(),
-           meat_end = AdMatrix::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
-    if (w == 0) continue;
-    const RightJacobianPair<AdMatrix> start = right_jacobian_pair<G>(Tangent(-u * x));
-    const RightJacobianPair<AdMatrix> end = right_jacobian_pair<G>(Tangent(t * x));
-    // Small fixed-size products are written as lazy (coefficient-wise)
-    // products: Eigen's blocked kernels cost more than the arithmetic here.
-    const Scalar k_weight = w * t * u;
-    k01_core.noalias() += (k_weight * start.inverse).lazyProduct(end.jacobian);
-    k10_core.noalias() += (k_weight * end.inverse).lazyProduct(start.jacobian);
-    if (flavour == CovarianceFlavour::homoscedastic) {
-      // w Psi_i S Psi_i^T w, with S = s_root s_root^T.
-      const AdMatrix start_spread = (w * u * start.inverse).lazyProduct(s_root);
-      const AdMatrix end_spread = (w * t * end.inverse).lazyProduct(s_root);
-      meat_start.noalias() += start_spread.lazyProduct(start_spread.transpose());
-      meat_cross.noalias() += start_spread.lazyProduct(end_spread.transpose());
-      meat_end.noalias() += end_spread.lazyProduct(end_spread.transpose());
-    } else {
-      const Vector2 l(u, t);
-      const Scalar v = 1 - 2 * w * l.dot(h_inverse * l) + l.dot(leverage_matrix * l);
-      if (!(v > Scalar(1e-12))) {
-        return refused<G>(CovarianceStatus::undefined,
-                          "observation " + std::to_string(i) +
-                              " has leverage 1 (its residual is zero by construction): the "
-                              "robust covariance is undefined");
-      }
-      const Scalar force_weight = w / sqrt(v);
-      ForceVector force;
-      force.template head<d>() = (force_weight * u * start.inverse).lazyProduct(residuals[i]);
-      force.template tail<d>() = (force_weight * t * end.inverse).lazyProduct(residuals[i]);
-      meat_start.noalias() +=
-          force.template head<d>().lazyProduct(force.template head<d>().transpose());
-      meat_cross.noalias() +=
-          force.template head<d>().lazyProduct(force.template tail<d>().transpose());
-      meat_end.noalias() +=
-          force.template tail<d>().lazyProduct(force.template tail<d>().transpose());
-      forces.push_back(force);
-    }
+  const covariance_detail::PassInputs<G> inputs{x, h_inverse, leverage_matrix,
+                                                covariance_detail::square_root(s), flavour};
+  covariance_detail::ObservationSums<G> sums;
+  if constexpr (provides_v<G, capability_detail::ad_algebra_basis>) {
+    sums = matrix_pass ? covariance_detail::sums_by_matrices(inputs, problem, residuals)
+                       : covariance_detail::sums_by_algebra(inputs, problem, residuals);
+  } else {
+    sums = covariance_detail::sums_by_matrices(inputs, problem, residuals);
   }
+  if (sums.leverage_one >= 0) {
+    return refused<G>(CovarianceStatus::undefined,
+                      "observation " + std::to_string(sums.leverage_one) +
+                          " has leverage 1 (its residual is zero by construction): the "
+                          "robust covariance is undefined");
+  }
+  const AdMatrix& k01_core = sums.k01_core;
+  const AdMatrix& k10_core = sums.k10_core;
+  const auto& forces = sums.forces;
+  const AdMatrix& meat_start = sums.meat_start;
+  const AdMatrix& meat_cross = sums.meat_cross;
+  const AdMatrix& meat_end = sums.meat_end;
   EndpointMatrix meat;
   meat.template topLeftCorner<d, d>() = meat_start;
   meat.template topRightCorner<d, d>() = meat_cross;
