@@ -7,7 +7,9 @@
 // BM_TrendTestThreads/<threads>: the permutation test, SE(3), N = 100
 // (the same data), B = 999; BM_SmoothThreads/<threads>: the local
 // regression of bench_local_regression.cpp (SO(3), 1e5 samples at 1 kHz,
-// noise 0.01 rad, Gaussian h = 2.5 samples, no standard errors).
+// noise 0.01 rad, Gaussian h = 2.5 samples, no standard errors);
+// BM_ModelSelectionThreads/<threads>: select_motion_model on 1000 poses of
+// the SE(3) data, its candidates' and cross-validation folds' fits.
 #include <random>
 #include <vector>
 
@@ -19,6 +21,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/model_selection.hpp"
 #include "bireg/statistics/trend_test.hpp"
 
 namespace {
@@ -102,6 +105,17 @@ void BM_SmoothThreads(benchmark::State& state) {
     benchmark::DoNotOptimize(smoother.smooth(f, t).data());
 }
 BENCHMARK(BM_SmoothThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// Motion-model selection of 1000 SE(3) poses (the same generator): five
+// candidates and their 5-fold cross-validation, 30 fits in all.
+void BM_ModelSelectionThreads(benchmark::State& state) {
+  const Data data = make_data(1000);
+  bireg::ModelSelectionOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(bireg::select_motion_model(data.f, data.t, options).recommended);
+}
+BENCHMARK(BM_ModelSelectionThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

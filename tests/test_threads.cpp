@@ -15,6 +15,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/model_selection.hpp"
 #include "bireg/statistics/trend_test.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -172,4 +173,49 @@ TEST_CASE("the local regression is identical for 1, 2 and 7 threads", "[threads]
   options.threads = 0;
   const auto refused = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
   REQUIRE(refused[0].message == "threads must be at least 1, got 0");
+}
+
+// The motion-model candidates and their (candidate, fold) cross-validation
+// fits run as tasks: every number of the selection must be the serial one,
+// and the static-or-geodesic selection likewise.
+TEST_CASE("model selection is identical for 1, 2 and 7 threads", "[threads]") {
+  std::vector<G::Element> f;
+  std::vector<double> t;
+  make_observations(120, f, t);
+  bireg::ModelSelectionOptions options;
+  const bireg::ModelSelection serial = bireg::select_motion_model(f, t, options);
+  REQUIRE(serial.recommended);
+  const auto trend_serial = bireg::select_static_or_geodesic<G>(f, t, options);
+  REQUIRE(trend_serial.recommended);
+  for (const int threads : {2, 7}) {
+    CAPTURE(threads);
+    options.threads = threads;
+    const bireg::ModelSelection parallel = bireg::select_motion_model(f, t, options);
+    REQUIRE(parallel.recommended == serial.recommended);
+    REQUIRE(parallel.ambiguous == serial.ambiguous);
+    REQUIRE(parallel.candidates.size() == serial.candidates.size());
+    for (std::size_t c = 0; c < serial.candidates.size(); ++c) {
+      const bireg::CandidateReport& a = parallel.candidates[c];
+      const bireg::CandidateReport& b = serial.candidates[c];
+      REQUIRE(a.model == b.model);
+      REQUIRE(a.fitted == b.fitted);
+      REQUIRE(a.note == b.note);
+      REQUIRE(a.log_det == b.log_det);
+      REQUIRE(a.criterion == b.criterion);
+      REQUIRE(a.rotation_rms_degrees == b.rotation_rms_degrees);
+      REQUIRE(a.translation_rms == b.translation_rms);
+      REQUIRE(a.cv_error.has_value());
+      REQUIRE(a.cv_error == b.cv_error);
+    }
+    const auto trend_parallel = bireg::select_static_or_geodesic<G>(f, t, options);
+    REQUIRE(trend_parallel.recommended == trend_serial.recommended);
+    for (std::size_t c = 0; c < trend_serial.candidates.size(); ++c) {
+      REQUIRE(trend_parallel.candidates[c].criterion == trend_serial.candidates[c].criterion);
+      REQUIRE(trend_parallel.candidates[c].cv_error == trend_serial.candidates[c].cv_error);
+    }
+  }
+  options.threads = 0;
+  REQUIRE(bireg::select_motion_model(f, t, options).message == "threads must be at least 1, got 0");
+  REQUIRE(bireg::select_static_or_geodesic<G>(f, t, options).message ==
+          "threads must be at least 1, got 0");
 }

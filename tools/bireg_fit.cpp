@@ -46,8 +46,9 @@
 // the plain fit (the robust weights depend on the covariates, so
 // permuting them with fixed weights would not be exchangeable).
 // --threads N (default: every core) runs the permuted fits of the trend
-// test, and the force of fits of 8192 observations or more, on N threads;
-// the output does not depend on N.
+// test, the candidates' and cross-validation folds' fits of --group auto,
+// and the force of fits of 8192 observations or more, on N threads; the
+// output does not depend on N.
 // Statistics that are undefined (N = 2, zero residuals, ...) are reported
 // in the JSON by "covariance_defined": false (or "defined": false) and a
 // "message", never by NaN or null, and give exit code 5
@@ -477,7 +478,8 @@ int main(int argc, char** argv) {
                    kUsage);
       return kExitInvalid;
     }
-    return bireg_cli::run_auto({command.input, command.output_trajectory, command.output_format});
+    return bireg_cli::run_auto(
+        {command.input, command.output_trajectory, command.output_format, command.threads});
   }
   if (command.group == "SO2") return run<bireg::SO2<double>>(command);
   if (command.group == "SO3") return run<bireg::SO3<double>>(command);

@@ -118,6 +118,7 @@ int run_auto(const AutoCommand& command) {
   }
   bireg::ModelSelectionOptions options;
   options.group = group;
+  options.threads = command.threads;
   const bireg::ModelSelection selection =
       bireg::select_motion_model(trajectory.observations, trajectory.covariates, options);
   const std::optional<bireg::MotionPrediction>& prediction = selection.prediction;

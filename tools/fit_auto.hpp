@@ -35,6 +35,7 @@ struct AutoCommand {
   InputOptions input;
   std::string output_trajectory;                   // empty: none
   std::optional<bireg::io::Format> output_format;  // empty: the input's
+  int threads = 1;                                 // the candidates' and folds' fits
 };
 
 // Exit codes as bireg_fit's: 0 a model recommended, 2 invalid input, 3 no

@@ -113,6 +113,7 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/mean.hpp"
 
 namespace bireg {
@@ -182,6 +183,11 @@ inline constexpr double kSelectionMargin = 1.0;
 struct ModelSelectionOptions {
   int folds = 5;                     // K of the cross-validation; below 2: no cross-validation
   PoseGroup group = PoseGroup::se3;  // sim3: similarities, six candidates
+  // Threads (>= 1) for the candidates' fits and the cross-validation's
+  // (candidate, fold) fits, each fit serial. The result does not depend on
+  // it: every task writes its own slot, and the folds' sums are added in
+  // fold order. A std::bad_alloc on a worker terminates.
+  int threads = 1;
 };
 
 struct CandidateReport {
@@ -337,16 +343,26 @@ inline std::vector<int> fold_of(const std::vector<double>& times, int folds) {
   return fold;
 }
 
-// K-fold cross-validated prediction error: the mean over i of
-// |residual(the prediction fitted without i's fold, f_i, t_i)|^2, or
-// nothing if a fold's fit fails. `fit(train, train_times)` returns an
-// optional prediction; training sets are vectors of Element.
-template <class Element, class Observations, class Fit, class Residual>
-std::optional<double> cv_error(const Observations& observations, const std::vector<double>& times,
-                               int folds, const Fit& fit, const Residual& residual) {
+// K-fold cross-validated prediction errors of `candidates` models: for
+// each, the mean over i of |residual(the prediction fitted without i's
+// fold, f_i, t_i)|^2, or nothing if the model is not `fitted(c)` or a fold's
+// fit fails. `fit(c, train, train_times)` returns an optional prediction;
+// training sets are vectors of Element. The (candidate, fold) fits run as
+// tasks on `threads` threads; each fold's squared sum is kept apart and the
+// folds are added in order, so the errors do not depend on `threads`.
+template <class Element, class Observations, class Fitted, class Fit, class Residual>
+std::vector<std::optional<double>> cv_errors(const Observations& observations,
+                                             const std::vector<double>& times, int folds,
+                                             std::size_t candidates, const Fitted& fitted,
+                                             const Fit& fit, const Residual& residual,
+                                             int threads) {
   const std::vector<int> fold = fold_of(times, folds);
-  double squared_sum = 0;
-  for (int k = 0; k < folds; ++k) {
+  const std::size_t fold_count = static_cast<std::size_t>(folds);
+  std::vector<std::optional<double>> fold_sums(candidates * fold_count);
+  ChunkPool(threads).run(candidates * fold_count, [&](std::size_t task) {
+    const std::size_t c = task / fold_count;
+    const int k = static_cast<int>(task % fold_count);
+    if (!fitted(c)) return;
     std::vector<Element> train;
     std::vector<double> train_times;
     for (std::size_t i = 0; i < observations.size(); ++i) {
@@ -354,13 +370,25 @@ std::optional<double> cv_error(const Observations& observations, const std::vect
       train.push_back(observations[i]);
       train_times.push_back(times[i]);
     }
-    const auto prediction = fit(train, train_times);
-    if (!prediction) return std::nullopt;
+    const auto prediction = fit(c, train, train_times);
+    if (!prediction) return;
+    double squared_sum = 0;
     for (std::size_t i = 0; i < observations.size(); ++i)
       if (fold[i] == k)
         squared_sum += residual(*prediction, observations[i], times[i]).squaredNorm();
+    fold_sums[task] = squared_sum;
+  });
+  std::vector<std::optional<double>> errors(candidates);
+  for (std::size_t c = 0; c < candidates; ++c) {
+    double squared_sum = 0;
+    bool complete = true;
+    for (std::size_t k = 0; k < fold_count && complete; ++k) {
+      complete = fold_sums[c * fold_count + k].has_value();
+      if (complete) squared_sum += *fold_sums[c * fold_count + k];
+    }
+    if (complete) errors[c] = squared_sum / static_cast<double>(observations.size());
   }
-  return squared_sum / static_cast<double>(observations.size());
+  return errors;
 }
 
 template <class Tangent>
@@ -413,35 +441,37 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
     selection.message = "poses and times must be non-empty and of equal length";
     return selection;
   }
+  if (options.threads < 1) {
+    selection.message = "threads must be at least 1, got " + std::to_string(options.threads);
+    return selection;
+  }
   const double n_real = static_cast<double>(n);
   const double rad_to_deg = 180.0 / 3.14159265358979323846;
 
   std::vector<MotionModel> models(std::begin(kMotionModels), std::end(kMotionModels));
   if (group == PoseGroup::sim3) models.push_back(MotionModel::similarity);
-  std::vector<std::optional<MotionPrediction>> predictors;
-  std::vector<std::vector<Tangent>> residuals;
-  for (MotionModel model : models) {
-    CandidateReport report;
-    report.model = model;
-    report.parameters = parameter_count(model, group);
-    std::optional<MotionPrediction> predictor;
+  std::vector<std::optional<MotionPrediction>> predictors(models.size());
+  std::vector<std::vector<Tangent>> residuals(models.size());
+  selection.candidates.resize(models.size());
+  ChunkPool(options.threads).run(models.size(), [&](std::size_t c) {
+    CandidateReport& report = selection.candidates[c];
+    report.model = models[c];
+    report.parameters = parameter_count(report.model, group);
+    std::optional<MotionPrediction>& predictor = predictors[c];
     if (n_real < report.parameters) {
       report.note = "excluded: " + std::to_string(n) + " observations, fewer than its " +
                     std::to_string(report.parameters) + " parameters";
     } else {
-      predictor = fit_model<group>(model, poses, times);
+      predictor = fit_model<group>(report.model, poses, times);
       if (!predictor) report.note = "excluded: its fit failed";
     }
-    std::vector<Tangent> r;
     if (predictor) {
       report.fitted = true;
+      residuals[c].reserve(n);
       for (std::size_t i = 0; i < n; ++i)
-        r.push_back(residual<group>(*predictor, poses[i], times[i]));
+        residuals[c].push_back(residual<group>(*predictor, poses[i], times[i]));
     }
-    predictors.push_back(predictor);
-    residuals.push_back(r);
-    selection.candidates.push_back(report);
-  }
+  });
 
   const double floor = determinant_floor<G>(residuals.front(), poses);
 
@@ -460,14 +490,18 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
     report.log_scale_rms = std::sqrt(scale_squares / n_real);
     report.log_det = floored_log_det(residual_covariance(residuals[c]), floor);
     report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
-    if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds))
-      report.cv_error = cv_error<Pose>(
-          poses, times, options.folds,
-          [&report](const std::vector<Pose>& train, const std::vector<double>& train_times) {
-            return fit_model<group>(report.model, train, train_times);
-          },
-          residual<group>);
     if (!best || report.criterion < *best) best = report.criterion;
+  }
+  if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
+    const std::vector<std::optional<double>> errors = cv_errors<Pose>(
+        poses, times, options.folds, models.size(),
+        [&](std::size_t c) { return selection.candidates[c].fitted; },
+        [&](std::size_t c, const std::vector<Pose>& train, const std::vector<double>& train_times) {
+          return fit_model<group>(models[c], train, train_times);
+        },
+        residual<group>, options.threads);
+    for (std::size_t c = 0; c < models.size(); ++c)
+      selection.candidates[c].cv_error = errors[c];
   }
   if (!best) {
     selection.message = "no candidate could be fitted";
@@ -573,6 +607,10 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
     selection.message = "observations and times must be non-empty and of equal length";
     return selection;
   }
+  if (options.threads < 1) {
+    selection.message = "threads must be at least 1, got " + std::to_string(options.threads);
+    return selection;
+  }
   const double n_real = static_cast<double>(n);
   std::vector<std::vector<Tangent>> residuals;
   for (TrendModel model : {TrendModel::static_element, TrendModel::geodesic}) {
@@ -612,16 +650,20 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
     report.residual_rms = std::sqrt(squares / n_real);
     report.log_det = detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
     report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
-    if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
-      using Element = typename G::Element;
-      report.cv_error = detail::cv_error<Element>(
-          observations, times, options.folds,
-          [&report](const std::vector<Element>& train, const std::vector<double>& train_times) {
-            return detail::fit_trend_model<G>(report.model, train, train_times);
-          },
-          detail::trend_residual<G>);
-    }
     if (!best || report.criterion < *best) best = report.criterion;
+  }
+  if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
+    using Element = typename G::Element;
+    const std::vector<std::optional<double>> errors = detail::cv_errors<Element>(
+        observations, times, options.folds, selection.candidates.size(),
+        [&](std::size_t c) { return selection.candidates[c].fitted; },
+        [&](std::size_t c, const std::vector<Element>& train,
+            const std::vector<double>& train_times) {
+          return detail::fit_trend_model<G>(selection.candidates[c].model, train, train_times);
+        },
+        detail::trend_residual<G>, options.threads);
+    for (std::size_t c = 0; c < selection.candidates.size(); ++c)
+      selection.candidates[c].cv_error = errors[c];
   }
   if (!best) {
     selection.message = "neither model could be fitted";
