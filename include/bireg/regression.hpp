@@ -151,7 +151,7 @@ class GeodesicRegression {
       using Rule = typename decltype(tag)::type;
       if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
       const Rule rule(problem, options_.step_size);
-      const PsiEvaluation psi{options_.method, options_.series_order, options_.max_series_order};
+      const PsiEvaluation psi = options_.psi();
       const IterationControl<Scalar> control{options_.tolerance, options_.max_iterations,
                                              options_.record_iterates};
       Result result;

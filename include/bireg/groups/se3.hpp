@@ -147,10 +147,10 @@ struct SE3 {
     basis.theta2 = omega.squaredNorm();
     basis.theta = sqrt(basis.theta2);
     basis.kappa = omega.dot(rho);
-    const Matrix3 w = Rotation::hat(omega);
+    const Matrix3 w = Rotation::hat(omega), p = Rotation::hat(rho);
     const Matrix3 w2 = omega * omega.transpose() - basis.theta2 * Matrix3::Identity();
-    basis.a = ad(xi);
-    basis.a2 = block_triangular(w2, w * Rotation::hat(rho) + Rotation::hat(rho) * w);
+    basis.a = block_triangular(w, p);  // ad(xi)
+    basis.a2 = block_triangular(w2, w * p + p * w);
     basis.n1 = block_triangular(Matrix3::Zero(), w);
     basis.n2 = block_triangular(Matrix3::Zero(), w2);
     return basis;

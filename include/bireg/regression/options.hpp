@@ -12,6 +12,7 @@
 
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_series.hpp"
+#include "bireg/regression/estimating_equations.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/solver.hpp"
 #include "bireg/regression/status.hpp"
@@ -56,6 +57,9 @@ struct RegressionOptions {
   // threads - 1 workers for its duration; the results are bit-identical
   // for any value. 1 (the default): no thread is ever started.
   int threads = 1;
+
+  // How the estimating equations evaluate psi, from the fields above.
+  PsiEvaluation psi() const { return {method, series_order, max_series_order}; }
 };
 
 template <class Scalar>

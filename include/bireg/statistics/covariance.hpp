@@ -468,26 +468,20 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
                           " has leverage 1 (its residual is zero by construction): the "
                           "robust covariance is undefined");
   }
-  const AdMatrix& k01_core = sums.k01_core;
-  const AdMatrix& k10_core = sums.k10_core;
-  const auto& forces = sums.forces;
-  const AdMatrix& meat_start = sums.meat_start;
-  const AdMatrix& meat_cross = sums.meat_cross;
-  const AdMatrix& meat_end = sums.meat_end;
   EndpointMatrix meat;
-  meat.template topLeftCorner<d, d>() = meat_start;
-  meat.template topRightCorner<d, d>() = meat_cross;
-  meat.template bottomLeftCorner<d, d>() = meat_cross.transpose();
-  meat.template bottomRightCorner<d, d>() = meat_end;
+  meat.template topLeftCorner<d, d>() = sums.meat_start;
+  meat.template topRightCorner<d, d>() = sums.meat_cross;
+  meat.template bottomLeftCorner<d, d>() = sums.meat_cross.transpose();
+  meat.template bottomRightCorner<d, d>() = sums.meat_end;
 
   const AdMatrix identity = AdMatrix::Identity();
   const AdMatrix jacobian_back = right_jacobian<G>(Tangent(-x));
   const AdMatrix jacobian_forward = right_jacobian<G>(x);
   EndpointMatrix k;
   k.template topLeftCorner<d, d>() = problem.a * identity;
-  k.template topRightCorner<d, d>() = jacobian_back * k01_core * right_jacobian_inverse<G>(x);
+  k.template topRightCorner<d, d>() = jacobian_back * sums.k01_core * right_jacobian_inverse<G>(x);
   k.template bottomLeftCorner<d, d>() =
-      jacobian_forward * k10_core * right_jacobian_inverse<G>(Tangent(-x));
+      jacobian_forward * sums.k10_core * right_jacobian_inverse<G>(Tangent(-x));
   k.template bottomRightCorner<d, d>() = problem.c * identity;
   // Cov = K^{-1} D meat D^T K^{-T}, D = diag(J_r(-X), J_r(X)).
   EndpointMatrix outer = EndpointMatrix::Zero();
@@ -523,13 +517,13 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
     velocity_map.template leftCols<d>() = -right_jacobian_inverse<G>(Tangent(-x));
     velocity_map.template rightCols<d>() = right_jacobian_inverse<G>(x);
     result.effective.endpoints =
-        covariance_detail::satterthwaite(EndpointMatrix(bread), forces, meat_root);
+        covariance_detail::satterthwaite(EndpointMatrix(bread), sums.forces, meat_root);
     result.effective.start = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), sums.forces, meat_root);
     result.effective.end = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), sums.forces, meat_root);
     result.effective.velocity = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), sums.forces, meat_root);
     // Zero degrees of freedom: the quantity's robust covariance is zero,
     // every observation that bears on it fitting exactly (two identical
     // observations at t_min pin the start, whatever the others do).

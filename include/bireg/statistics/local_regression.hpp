@@ -456,8 +456,7 @@ class LocalGeodesicRegression {
       using Rule = typename decltype(tag)::type;
       if (Rule::refuse(problem, fit_options.step_size)) return false;
       const Rule rule = make_rule<Rule>(problem, *previous);
-      const PsiEvaluation psi{fit_options.method, fit_options.series_order,
-                              fit_options.max_series_order};
+      const PsiEvaluation psi = fit_options.psi();
       const IterationControl<Scalar> control{fit_options.tolerance, fit_options.max_iterations,
                                              false, Stopping::predicted};
       const State<G> state =

@@ -348,18 +348,18 @@ inline std::vector<int> fold_of(const std::vector<double>& times, int folds) {
 // fold, f_i, t_i)|^2, or nothing if the model is not `fitted(c)` or a fold's
 // fit fails. `fit(c, train, train_times)` returns an optional prediction;
 // training sets are vectors of Element. The (candidate, fold) fits run as
-// tasks on `threads` threads; each fold's squared sum is kept apart and the
-// folds are added in order, so the errors do not depend on `threads`.
+// tasks on `pool`; each fold's squared sum is kept apart and the folds are
+// added in order, so the errors do not depend on the pool's threads.
 template <class Element, class Observations, class Fitted, class Fit, class Residual>
 std::vector<std::optional<double>> cv_errors(const Observations& observations,
                                              const std::vector<double>& times, int folds,
                                              std::size_t candidates, const Fitted& fitted,
                                              const Fit& fit, const Residual& residual,
-                                             int threads) {
+                                             ChunkPool& pool) {
   const std::vector<int> fold = fold_of(times, folds);
   const std::size_t fold_count = static_cast<std::size_t>(folds);
   std::vector<std::optional<double>> fold_sums(candidates * fold_count);
-  ChunkPool(threads).run(candidates * fold_count, [&](std::size_t task) {
+  pool.run(candidates * fold_count, [&](std::size_t task) {
     const std::size_t c = task / fold_count;
     const int k = static_cast<int>(task % fold_count);
     if (!fitted(c)) return;
@@ -453,7 +453,8 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
   std::vector<std::optional<MotionPrediction>> predictors(models.size());
   std::vector<std::vector<Tangent>> residuals(models.size());
   selection.candidates.resize(models.size());
-  ChunkPool(options.threads).run(models.size(), [&](std::size_t c) {
+  ChunkPool pool(options.threads);  // the candidates' fits, then the folds'
+  pool.run(models.size(), [&](std::size_t c) {
     CandidateReport& report = selection.candidates[c];
     report.model = models[c];
     report.parameters = parameter_count(report.model, group);
@@ -499,7 +500,7 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
         [&](std::size_t c, const std::vector<Pose>& train, const std::vector<double>& train_times) {
           return fit_model<group>(models[c], train, train_times);
         },
-        residual<group>, options.threads);
+        residual<group>, pool);
     for (std::size_t c = 0; c < models.size(); ++c)
       selection.candidates[c].cv_error = errors[c];
   }
@@ -654,6 +655,7 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
   }
   if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
     using Element = typename G::Element;
+    ChunkPool pool(options.threads);
     const std::vector<std::optional<double>> errors = detail::cv_errors<Element>(
         observations, times, options.folds, selection.candidates.size(),
         [&](std::size_t c) { return selection.candidates[c].fitted; },
@@ -661,7 +663,7 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
             const std::vector<double>& train_times) {
           return detail::fit_trend_model<G>(selection.candidates[c].model, train, train_times);
         },
-        detail::trend_residual<G>, options.threads);
+        detail::trend_residual<G>, pool);
     for (std::size_t c = 0; c < selection.candidates.size(); ++c)
       selection.candidates[c].cv_error = errors[c];
   }

@@ -296,6 +296,11 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
   // covariates in another order pass make_problem alike. A fit that stops
   // without a decision or convergence is redone by fit() (its checks, its
   // start), and counts as failed only if that fails too.
+  const auto verdict_at = [&](const std::vector<typename G::Tangent>& residuals) {
+    return range.ratio(scatter_matrix(residuals, weights)) <= threshold
+               ? Verdict::at_least_as_extreme
+               : Verdict::less_extreme;
+  };
   const auto verdict_of = [&](std::size_t b, trend_detail::FitBuffers<G>& buffers) {
     permutation(options.seed, static_cast<std::uint64_t>(b), n, buffers.order);
     buffers.permuted.resize(n);
@@ -308,8 +313,7 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
             using Rule = typename decltype(tag)::type;
             if (Rule::refuse(problem, permuted_options.step_size)) return std::nullopt;
             const Rule rule(problem, permuted_options.step_size);
-            const PsiEvaluation psi{permuted_options.method, permuted_options.series_order,
-                                    permuted_options.max_series_order};
+            const PsiEvaluation psi = permuted_options.psi();
             const IterationControl<Scalar> control{permuted_options.tolerance,
                                                    permuted_options.max_iterations, false};
             const Endpoints first =
@@ -321,9 +325,7 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
                        &buffers.workspace, decision);
             if (buffers.record.decided) return decision.verdict();
             if (!is_success(buffers.record.status)) return std::nullopt;
-            return range.ratio(scatter_matrix(buffers.residuals, weights)) <= threshold
-                       ? Verdict::at_least_as_extreme
-                       : Verdict::less_extreme;
+            return verdict_at(buffers.residuals);
           });
       if (verdict) return *verdict;
     }
@@ -331,10 +333,7 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
         options.start == PermutationStart::chart
             ? permuted_regression.fit(observations, buffers.permuted, weights)
             : permuted_regression.fit_from(fixed_start, observations, buffers.permuted, weights);
-    if (!refit.ok()) return Verdict::failed;
-    return range.ratio(scatter_matrix(refit.residuals, weights)) <= threshold
-               ? Verdict::at_least_as_extreme
-               : Verdict::less_extreme;
+    return refit.ok() ? verdict_at(refit.residuals) : Verdict::failed;
   };
 
   // Blocks of permutations, each with its own buffers (no allocation per
