@@ -5,6 +5,7 @@
 // permutations and the local regression's queries (with its
 // leave-one-out errors) give identical results for 1, 2 and 7 threads. A
 // thread count below 1 is refused with a message, by each.
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -67,6 +68,10 @@ void require_identical(const Regression::Result& a, const Regression::Result& b)
   REQUIRE(a.diagnostics.contraction_factor == b.diagnostics.contraction_factor);
   REQUIRE(a.diagnostics.backtracks == b.diagnostics.backtracks);
   REQUIRE(a.diagnostics.series_order == b.diagnostics.series_order);
+  REQUIRE(a.diagnostics.residual_rms_about_mean == b.diagnostics.residual_rms_about_mean);
+  REQUIRE(a.diagnostics.largest_residual_angle == b.diagnostics.largest_residual_angle);
+  REQUIRE(a.diagnostics.largest_residual_observation == b.diagnostics.largest_residual_observation);
+  REQUIRE(a.diagnostics.beyond_domain == b.diagnostics.beyond_domain);
 }
 
 }  // namespace
@@ -84,6 +89,38 @@ TEST_CASE("fits are bit-identical for 1, 2 and 7 threads", "[threads]") {
       require_identical(serial, fit_with(7, method, f, t));
     }
   }
+}
+
+// The observation check and the chart pass run by chunks of 4096 on the
+// pool: with bad observations in two chunks, the fit names the first, as a
+// serial scan would, whatever the thread count.
+TEST_CASE("the first bad observation is named for 1, 2 and 7 threads", "[threads]") {
+  std::vector<G::Element> good;
+  std::vector<double> t;
+  make_observations(20000, good, t);
+  const auto first_failure = [&](const std::vector<G::Element>& f, const std::string& problem) {
+    for (const int threads : {1, 2, 7}) {
+      CAPTURE(threads, problem);
+      Regression::Options options;
+      options.threads = threads;
+      const auto result = Regression(options).fit(f, t);
+      REQUIRE(result.status == bireg::Status::invalid_input);
+      REQUIRE(result.bad_index == 9000);
+      REQUIRE(result.message.rfind("observation 9000 " + problem, 0) == 0);
+    }
+  };
+  std::vector<G::Element> f = good;
+  f[9000].topLeftCorner<3, 3>() *= 1.5;  // not a rotation
+  f[15000](0, 3) = std::nan("");
+  first_failure(f, "is not an element of SE3");
+  f = good;
+  f[9000](1, 3) = std::numeric_limits<double>::infinity();
+  f[15000].topLeftCorner<3, 3>() *= 1.5;
+  first_failure(f, "has non-finite entries");
+  f = good;  // elements, but 1e200 away from the middle observation: the chart's check
+  f[9000](2, 3) = 1e200;
+  f[15000](2, 3) = 1e200;
+  first_failure(f, "lies too far from the middle observation");
 }
 
 TEST_CASE("a thread count below 1 is refused", "[threads]") {

@@ -119,7 +119,13 @@ class GeodesicRegression {
     if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
       return rejected(*rejection);
     }
-    if (auto rejection = check_observations<G>(observations, options_.element_tolerance)) {
+    // The pool lives as long as this fit and serves every pass over the
+    // observations (parallel.hpp); below kParallelMinimum there is none.
+    std::optional<ChunkPool> pool;
+    if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads);
+    ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
+    if (auto rejection =
+            check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
       return rejected(*rejection);
     }
     if (start && (!G::is_element(start->first, options_.element_tolerance) ||
@@ -128,7 +134,7 @@ class GeodesicRegression {
     }
 
     // 2. The start.
-    const ChartStart<G> chart = chart_start<G>(observations, problem);
+    const ChartStart<G> chart = chart_start<G>(observations, problem, chunk_pool);
     if (chart.no_logarithm >= 0) {
       return rejected({"observation " + std::to_string(chart.no_logarithm) +
                            " is out of reach of the middle observation: no principal logarithm "
@@ -150,16 +156,13 @@ class GeodesicRegression {
     return with_step_rule<G>(options_.solver, [&](auto tag) {
       using Rule = typename decltype(tag)::type;
       if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
-      const Rule rule(problem, options_.step_size);
+      const Rule rule = make_rule<Rule>(problem, chunk_pool);
       const PsiEvaluation psi = options_.psi();
       const IterationControl<Scalar> control{options_.tolerance, options_.max_iterations,
                                              options_.record_iterates};
       Result result;
       IterationRecord<G> record;
-      // The pool lives as long as this fit and serves every evaluation.
-      std::optional<ChunkPool> pool;
-      if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads);
-      ForceWorkspace<G> workspace(pool ? &*pool : nullptr, n);
+      ForceWorkspace<G> workspace(chunk_pool, n);
       const State<G> state =
           iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
                      chart.reference, result.residuals, record, &workspace);
@@ -174,13 +177,24 @@ class GeodesicRegression {
       result.status = record.status;
       result.iterations = record.iterations;
       result.diagnostics =
-          diagnose<G>(problem, rule, record, state, chart.spread, result.residuals);
+          diagnose<G>(problem, rule, record, state, chart.spread, result.residuals, chunk_pool);
       result.step_norms = std::move(record.step_norms);
       result.iterates = std::move(record.iterates);
       result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
                                     static_cast<Scalar>(problem.t_max));
       return result;
     });
+  }
+
+  // The step rule for this fit; the Gauss-Newton rule sums its moments on
+  // the pool.
+  template <class Rule>
+  Rule make_rule(const Problem<Scalar>& problem, ChunkPool* pool) const {
+    if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
+      return Rule(problem, options_.step_size, kGaussNewtonOrder, pool);
+    } else {
+      return Rule(problem, options_.step_size);
+    }
   }
 
   // K at the returned endpoints: from the Gauss-Newton rule's coefficients

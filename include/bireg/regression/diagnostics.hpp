@@ -10,6 +10,7 @@
 #include "bireg/groups/capabilities.hpp"
 #include "bireg/regression/estimating_equations.hpp"
 #include "bireg/regression/iteration.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 
 namespace bireg {
@@ -74,7 +75,7 @@ template <class G, class Rule>
 RegressionDiagnostics<typename G::Scalar> diagnose(
     const Problem<typename G::Scalar>& problem, const Rule& rule, const IterationRecord<G>& record,
     const State<G>& state, typename G::Scalar spread,
-    const std::vector<typename G::Tangent>& residuals) {
+    const std::vector<typename G::Tangent>& residuals, ChunkPool* pool = nullptr) {
   using Scalar = typename G::Scalar;
   using std::sqrt;
   RegressionDiagnostics<Scalar> d;
@@ -90,22 +91,44 @@ RegressionDiagnostics<typename G::Scalar> diagnose(
   if (steps >= 2 && record.step_norms[steps - 2] > 0) {
     d.contraction_factor = record.step_norms[steps - 1] / record.step_norms[steps - 2];
   }
-  Scalar residual_sum = 0;
-  for (std::size_t i = 0; i < residuals.size(); ++i) {
-    residual_sum += problem.w[i] * residuals[i].squaredNorm();
-  }
+  // sum w |r_i|^2 and the largest residual angle (the first observation of
+  // equals), by chunks on `pool` when one is given.
+  struct Sums {
+    Scalar residual_sum = 0;
+    Scalar largest_angle = 0;
+    std::ptrdiff_t largest_observation = -1;
+  };
+  const Sums sums = reduce_chunks<Sums>(
+      residuals.size(), pool,
+      [&](std::size_t begin, std::size_t end) {
+        Sums chunk;
+        for (std::size_t i = begin; i < end; ++i) {
+          chunk.residual_sum += problem.w[i] * residuals[i].squaredNorm();
+          if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
+            if (problem.w[i] == 0) continue;  // a zero weight takes the observation out of the fit
+            const Scalar angle = G::ad_spectral_radius(residuals[i]);
+            if (angle > chunk.largest_angle) {
+              chunk.largest_angle = angle;
+              chunk.largest_observation = static_cast<std::ptrdiff_t>(i);
+            }
+          }
+        }
+        return chunk;
+      },
+      [](Sums& total, const Sums& next) {
+        total.residual_sum += next.residual_sum;
+        if (next.largest_angle > total.largest_angle) {
+          total.largest_angle = next.largest_angle;
+          total.largest_observation = next.largest_observation;
+        }
+      });
+  const Scalar residual_sum = sums.residual_sum;
   d.residual_rms = sqrt(residual_sum / problem.weight_sum);
   d.residual_rms_about_mean = sqrt(spread / problem.weight_sum);
   d.explained_variance = spread > 0 ? 1 - residual_sum / spread : Scalar(1);
   if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
-    for (std::size_t i = 0; i < residuals.size(); ++i) {
-      if (problem.w[i] == 0) continue;  // a zero weight takes the observation out of the fit
-      const Scalar angle = G::ad_spectral_radius(residuals[i]);
-      if (angle > d.largest_residual_angle) {
-        d.largest_residual_angle = angle;
-        d.largest_residual_observation = static_cast<std::ptrdiff_t>(i);
-      }
-    }
+    d.largest_residual_angle = sums.largest_angle;
+    d.largest_residual_observation = sums.largest_observation;
     d.beyond_domain = d.largest_residual_angle > kBeyondDomainAngle<Scalar>;
   }
   return d;

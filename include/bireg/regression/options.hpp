@@ -52,8 +52,9 @@ struct RegressionOptions {
   Scalar element_tolerance = default_element_tolerance<Scalar>();
   // Keep (g0, g1) after every step in Result::iterates.
   bool record_iterates = false;
-  // Threads summing the force over the observations (parallel.hpp), at
-  // least 1. A fit of more than kParallelMinimum observations starts
+  // Threads for the passes over the observations (parallel.hpp: the check,
+  // the chart start, the Gauss-Newton moments, the force, the diagnostics),
+  // at least 1. A fit of kParallelMinimum observations or more starts
   // threads - 1 workers for its duration; the results are bit-identical
   // for any value. 1 (the default): no thread is ever started.
   int threads = 1;

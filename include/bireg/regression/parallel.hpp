@@ -11,11 +11,13 @@
 // pointer and a context (no std::function, no allocation per run).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace bireg {
@@ -112,5 +114,32 @@ class ChunkPool {
   std::atomic<std::size_t> next_{0};
   std::size_t busy_ = 0;
 };
+
+// A once-per-fit pass over observations [0, n) (the observation check, the
+// chart, the Gauss-Newton moments, the diagnostics) by chunks:
+// body(begin, end) returns a chunk's Partial, and combine(total, next)
+// folds the partials into the first in chunk order, so the result is the
+// same arithmetic with or without a pool, for any thread count. One chunk
+// calls body(0, n) and allocates nothing; more allocate their partials
+// once (not for the iteration's loop: the force keeps its own workspace).
+template <class Partial, class Body, class Combine>
+Partial reduce_chunks(std::size_t n, ChunkPool* pool, const Body& body, const Combine& combine) {
+  const std::size_t chunks = chunk_count(n);
+  if (chunks <= 1) return body(std::size_t(0), n);
+  std::vector<Partial> partials(chunks);
+  const auto run_chunk = [&](std::size_t chunk) {
+    partials[chunk] = body(chunk * kChunkSize, std::min(n, (chunk + 1) * kChunkSize));
+  };
+  if (pool) {
+    pool->run(chunks, run_chunk);
+  } else {
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
+      run_chunk(chunk);
+  }
+  Partial total = std::move(partials[0]);
+  for (std::size_t chunk = 1; chunk < chunks; ++chunk)
+    combine(total, partials[chunk]);
+  return total;
+}
 
 }  // namespace bireg

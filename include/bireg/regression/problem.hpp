@@ -23,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include "bireg/regression/parallel.hpp"
+
 namespace bireg {
 
 // Why a fit was refused, and the observation at fault (-1: none).
@@ -151,23 +153,36 @@ std::optional<Rejection> make_problem(
   return std::nullopt;
 }
 
-// Every observation finite and in the group (to `tolerance`).
+// Every observation finite and in the group (to `tolerance`); the first
+// that is not is named. By chunks on `pool` when one is given.
 template <class G, class Observations>
 std::optional<Rejection> check_observations(const Observations& observations,
-                                            typename G::Scalar tolerance) {
-  for (std::size_t i = 0; i < observations.size(); ++i) {
-    const typename G::Element& f = observations[i];
-    const auto index = static_cast<std::ptrdiff_t>(i);
-    if (!f.allFinite()) {
-      return Rejection{"observation " + std::to_string(i) + " has non-finite entries", index};
-    }
-    if (!G::is_element(f, tolerance)) {
-      return Rejection{"observation " + std::to_string(i) + " is not an element of " + G::name +
-                           " (to tolerance " + std::to_string(double(tolerance)) + ")",
-                       index};
-    }
-  }
-  return std::nullopt;
+                                            typename G::Scalar tolerance,
+                                            ChunkPool* pool = nullptr) {
+  struct Finding {
+    std::ptrdiff_t index = -1;  // the first observation that fails, or -1
+    bool finite = true;         // whether it fails by non-finite entries or by membership
+  };
+  const Finding found = reduce_chunks<Finding>(
+      observations.size(), pool,
+      [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const typename G::Element& f = observations[i];
+          const auto index = static_cast<std::ptrdiff_t>(i);
+          if (!f.allFinite()) return Finding{index, false};
+          if (!G::is_element(f, tolerance)) return Finding{index, true};
+        }
+        return Finding{};
+      },
+      [](Finding& first, const Finding& next) {
+        if (first.index < 0) first = next;
+      });
+  if (found.index < 0) return std::nullopt;
+  const std::string observation = "observation " + std::to_string(found.index);
+  if (!found.finite) return Rejection{observation + " has non-finite entries", found.index};
+  return Rejection{observation + " is not an element of " + G::name + " (to tolerance " +
+                       std::to_string(double(tolerance)) + ")",
+                   found.index};
 }
 
 }  // namespace bireg

@@ -29,6 +29,7 @@
 #include <utility>
 
 #include "bireg/geodesic.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 
 namespace bireg {
@@ -74,36 +75,63 @@ std::pair<Tangent, Tangent> least_squares_line(const Problem<Scalar>& problem,
           (problem.a * moment1 - problem.b * moment0) / determinant};
 }
 
+// By chunks on `pool` when one is given (parallel.hpp: the same sums for
+// any thread count).
 template <class G, class Observations>
 ChartStart<G> chart_start(const Observations& observations,
-                          const Problem<typename G::Scalar>& problem) {
+                          const Problem<typename G::Scalar>& problem, ChunkPool* pool = nullptr) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
-  const std::size_t n = observations.size();
   const typename G::Element& f_ref = observations[middle_observation(problem)];
   const typename G::Element f_ref_inverse = G::inverse(f_ref);
-  Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
-  Scalar square_sum = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
-    const bool finite = y.allFinite();
-    if (!finite || y.cwiseAbs().maxCoeff() > largest_tangent<Scalar>()) {
-      ChartStart<G> outside;
-      outside.g0 = outside.g1 = outside.reference = f_ref;
-      (finite ? outside.too_large : outside.no_logarithm) = static_cast<std::ptrdiff_t>(i);
-      return outside;
-    }
-    moment0 += problem.w[i] * (1 - problem.t[i]) * y;
-    moment1 += problem.w[i] * problem.t[i] * y;
-    square_sum += problem.w[i] * y.squaredNorm();
-  }
-  const auto [x0, x1] = least_squares_line(problem, moment0, moment1);
-  const Tangent total = moment0 + moment1;  // sum w y
+  // sum w (1 - t) y, sum w t y and sum w |y|^2 over a chunk, or the first
+  // observation of the chunk whose y_i is not finite or too large.
+  struct Sums {
+    Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
+    Scalar square_sum = 0;
+    std::ptrdiff_t no_logarithm = -1, too_large = -1;
+    bool outside() const { return no_logarithm >= 0 || too_large >= 0; }
+  };
+  const Sums sums = reduce_chunks<Sums>(
+      observations.size(), pool,
+      [&](std::size_t begin, std::size_t end) {
+        Sums chunk;
+        for (std::size_t i = begin; i < end; ++i) {
+          const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
+          const bool finite = y.allFinite();
+          if (!finite || y.cwiseAbs().maxCoeff() > largest_tangent<Scalar>()) {
+            (finite ? chunk.too_large : chunk.no_logarithm) = static_cast<std::ptrdiff_t>(i);
+            return chunk;
+          }
+          chunk.moment0 += problem.w[i] * (1 - problem.t[i]) * y;
+          chunk.moment1 += problem.w[i] * problem.t[i] * y;
+          chunk.square_sum += problem.w[i] * y.squaredNorm();
+        }
+        return chunk;
+      },
+      [](Sums& total, const Sums& next) {
+        if (total.outside()) return;  // the first such observation is the one reported
+        if (next.outside()) {
+          total = next;
+          return;
+        }
+        total.moment0 += next.moment0;
+        total.moment1 += next.moment1;
+        total.square_sum += next.square_sum;
+      });
   ChartStart<G> chart;
   chart.reference = f_ref;
+  if (sums.outside()) {
+    chart.g0 = chart.g1 = f_ref;
+    chart.no_logarithm = sums.no_logarithm;
+    chart.too_large = sums.too_large;
+    return chart;
+  }
+  const auto [x0, x1] = least_squares_line(problem, sums.moment0, sums.moment1);
+  const Tangent total = sums.moment0 + sums.moment1;  // sum w y
   chart.g0 = exp_at<G>(f_ref, x0);
   chart.g1 = exp_at<G>(f_ref, x1);
-  chart.spread = std::max(Scalar(0), square_sum - total.squaredNorm() / problem.weight_sum);
+  chart.spread = std::max(Scalar(0), sums.square_sum - total.squaredNorm() / problem.weight_sum);
   return chart;
 }
 

@@ -33,6 +33,7 @@
 
 #include "bireg/math/psi_series.hpp"
 #include "bireg/regression/estimating_equations.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 
 namespace bireg {
@@ -66,25 +67,41 @@ class GaussNewtonStep {
   // the iterates' spectral radius stays small (the local regression's warm
   // fits) takes fewer terms. Truncation changes K, hence the contraction
   // factor, never the fixed point.
-  GaussNewtonStep(const Problem<Scalar>& problem, Scalar, int order = kGaussNewtonOrder)
+  // By chunks of observations on `pool` when one is given (parallel.hpp:
+  // the same sums for any thread count).
+  GaussNewtonStep(const Problem<Scalar>& problem, Scalar, int order = kGaussNewtonOrder,
+                  ChunkPool* pool = nullptr)
       : a_(problem.a), c_(problem.c), order_(std::clamp(order, 0, kGaussNewtonOrder)) {
     constexpr int kMaxPowers = kGaussNewtonOrder + 2;
     const int powers = order_ + 2;
-    std::array<std::array<Scalar, kMaxPowers + 1>, kMaxPowers + 1> moments{};
-    std::array<Scalar, kMaxPowers + 1> t_power{}, u_power{};
-    for (std::size_t i = 0; i < problem.size(); ++i) {
-      const Scalar t = problem.t[i], u = 1 - t;
-      t_power[0] = problem.w[i];
-      u_power[0] = 1;
-      for (int j = 1; j <= powers; ++j) {
-        t_power[j] = t_power[j - 1] * t;
-        u_power[j] = u_power[j - 1] * u;
-      }
-      for (int p = 1; p < powers; ++p) {
-        for (int q = 1; p + q <= powers; ++q)
-          moments[p][q] += t_power[p] * u_power[q];
-      }
-    }
+    using Moments = std::array<std::array<Scalar, kMaxPowers + 1>, kMaxPowers + 1>;
+    using Powers = std::array<Scalar, kMaxPowers + 1>;
+    const Moments moments = reduce_chunks<Moments>(
+        problem.size(), pool,
+        [&](std::size_t begin, std::size_t end) {
+          Moments chunk{};
+          Powers t_power{}, u_power{};
+          for (std::size_t i = begin; i < end; ++i) {
+            const Scalar t = problem.t[i], u = 1 - t;
+            t_power[0] = problem.w[i];
+            u_power[0] = 1;
+            for (int j = 1; j <= powers; ++j) {
+              t_power[j] = t_power[j - 1] * t;
+              u_power[j] = u_power[j - 1] * u;
+            }
+            for (int p = 1; p < powers; ++p) {
+              for (int q = 1; p + q <= powers; ++q)
+                chunk[p][q] += t_power[p] * u_power[q];
+            }
+          }
+          return chunk;
+        },
+        [powers](Moments& total, const Moments& next) {
+          for (int p = 1; p < powers; ++p) {
+            for (int q = 1; p + q <= powers; ++q)
+              total[p][q] += next[p][q];
+          }
+        });
     for (int m = 0; m <= order_; ++m) {
       Scalar start = 0, end = 0;
       for (int k = 0; k <= m; ++k) {
