@@ -1,10 +1,10 @@
 // Cost of the group primitives: one exp, one log and two compositions, the
-// floor every inverse-differential method pays per observation and
-// iteration; and SO(3) exp and SE(3) log alone against reference
-// formulas (issue 16): the previous Rodrigues form (W^2 by a 3 x 3
-// product) and the route Sophus takes (a quaternion from the half angle,
-// then its matrix; for the log, the quaternion of the matrix, an atan and
-// V^{-1} from sin and cos of the half angle). The references are written
+// floor every inverse-differential method pays per observation and iteration
+// (SO(2), SO(3), SE(2), SE(3), Sim(3)); and SO(3) exp and SE(3) log alone
+// against reference formulas (issue 16): the previous Rodrigues form (W^2 by
+// a 3 x 3 product) and the route Sophus takes (a quaternion from the half
+// angle, then its matrix; for the log, the quaternion of the matrix, an atan
+// and V^{-1} from sin and cos of the half angle). The references are written
 // here from the formulas; Sophus is not a dependency.
 #include <cmath>
 #include <random>
@@ -15,6 +15,7 @@
 
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 
@@ -50,6 +51,7 @@ BENCHMARK_TEMPLATE(BM_ExpLogTwoCompositions, bireg::SO2<double>);
 BENCHMARK_TEMPLATE(BM_ExpLogTwoCompositions, bireg::SO3<double>);
 BENCHMARK_TEMPLATE(BM_ExpLogTwoCompositions, bireg::SE2<double>);
 BENCHMARK_TEMPLATE(BM_ExpLogTwoCompositions, bireg::SE3<double>);
+BENCHMARK_TEMPLATE(BM_ExpLogTwoCompositions, bireg::Sim3<double>);
 
 using SO3 = bireg::SO3<double>;
 using SE3 = bireg::SE3<double>;

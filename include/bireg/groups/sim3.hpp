@@ -27,6 +27,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
@@ -82,10 +83,19 @@ Coefficients<Scalar> coefficients(Scalar sigma, Scalar theta) {
   using std::cos;
   using std::exp;
   using std::expm1;
+  using std::sqrt;
   static constexpr auto kInverseFactorial = inverse_factorials();
   const Scalar modulus2 = sigma * sigma + theta * theta;
   if (modulus2 < Scalar(kSeriesRadius * kSeriesRadius)) {
-    Scalar sigma_power = 1, h_previous = 0, h = 1, g = 1;
+    // The terms of index m are bounded by |z|^m / m! (h_m by (m + 1) |z|^m,
+    // g_m by (m + 1)(m + 2) |z|^m / 2), a bound that falls from m = 2 on
+    // and also bounds the rest of the series past m. For sigma >= 0 every
+    // term is positive and A >= 1, B >= 1/2, C >= 1/6, so stopping once the
+    // bound is below epsilon / 64 leaves less than epsilon / 10 relative:
+    // in double 12 terms at |z| = 0.1, 21 at 1, 26 at 2 (of kSeriesTerms = 28).
+    const Scalar modulus = sqrt(modulus2);
+    const Scalar stop = std::numeric_limits<Scalar>::epsilon() / 64;
+    Scalar sigma_power = 1, h_previous = 0, h = 1, g = 1, bound = 1;
     Coefficients<Scalar> c{0, 0, 0};
     for (std::size_t m = 0; m < kSeriesTerms; ++m) {
       if (m > 0) {
@@ -94,10 +104,12 @@ Coefficients<Scalar> coefficients(Scalar sigma, Scalar theta) {
         h = h_next;
         g = h + sigma * g;
         sigma_power *= sigma;
+        bound *= modulus / static_cast<Scalar>(m);
       }
       c.A += sigma_power * static_cast<Scalar>(kInverseFactorial[m + 1]);
       c.B += h * static_cast<Scalar>(kInverseFactorial[m + 2]);
       c.C += g * static_cast<Scalar>(kInverseFactorial[m + 3]);
+      if (m >= 2 && bound < stop) break;
     }
     return c;
   }
