@@ -66,6 +66,8 @@ template <class G>
 using ad_algebra_basis = decltype(G::ad_algebra_basis(std::declval<const Tangent<G>&>()));
 template <class G>
 using closed_form_psi = typename G::ClosedFormPsi;
+template <class Psi>
+using closed_form_min_angle = decltype(Psi::kMinAngle);
 }  // namespace capability_detail
 
 // J_r(x) and its inverse at one x.
@@ -159,8 +161,26 @@ RightJacobianPair<typename G::AdMatrix> right_jacobian_pair(const typename G::Ta
   }
 }
 
-// psi_s(ad_x) r as the exact method evaluates it: G's closed form from
-// kExactMinAngle on; below it, and for groups without one, the series
+// Whether the exact method evaluates psi_s(ad_x) by G's closed form: from
+// ClosedFormPsi::angle(x) = kExactMinAngle on, or from the group's own
+// ClosedFormPsi::kMinAngle where it declares one (Sim(3), whose closed form
+// costs more than the series on short geodesics).
+template <class G>
+bool uses_closed_form_psi(const typename G::Tangent& x) {
+  if constexpr (has_closed_form_psi_v<G>) {
+    using Psi = typename G::ClosedFormPsi;
+    double min_angle = kExactMinAngle;
+    if constexpr (provides_v<Psi, capability_detail::closed_form_min_angle>) {
+      min_angle = Psi::kMinAngle;
+    }
+    return Psi::angle(x) >= static_cast<typename G::Scalar>(min_angle);
+  } else {
+    return false;
+  }
+}
+
+// psi_s(ad_x) r as the exact method evaluates it: G's closed form where
+// uses_closed_form_psi; elsewhere, and for groups without one, the series
 // truncated adaptively below epsilon.
 template <class G>
 typename G::Tangent apply_psi(const typename G::Tangent& x, typename G::Scalar s,
@@ -168,7 +188,7 @@ typename G::Tangent apply_psi(const typename G::Tangent& x, typename G::Scalar s
   using Scalar = typename G::Scalar;
   if constexpr (has_closed_form_psi_v<G>) {
     using Psi = typename G::ClosedFormPsi;
-    if (Psi::angle(x) >= static_cast<Scalar>(kExactMinAngle)) {
+    if (uses_closed_form_psi<G>(x)) {
       using SinCos = psi_closed_form::SinCos<Scalar>;
       const auto prepared = Psi::prepare(x);
       return Psi::apply(prepared, s, SinCos::of(s * prepared.theta / 2),

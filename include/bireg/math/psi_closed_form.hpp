@@ -2,7 +2,9 @@
 // psi_s(ad_X) in closed form (DESIGN.md section 2, "Exact form"). The groups
 // whose ad_X has eigenvalues 0 and +-i theta only (SO(2), SO(3), SE(2),
 // SE(3)) assemble psi_s(ad_X) r from them in their own headers
-// (ClosedFormPsi); this header holds the part they share.
+// (ClosedFormPsi); this header holds the part they share. Sim(3), whose
+// ad_X also has the eigenvalues sigma and sigma +- i theta, has its own
+// closed form in groups/sim3.hpp.
 //
 // On these groups ad_X has eigenvalues 0 and +-i theta (theta the rotation
 // angle), so any analytic F(ad_X) is fixed by F and F' at 0 and i theta. For

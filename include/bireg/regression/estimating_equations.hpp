@@ -258,8 +258,7 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
     return state;
   }
   if constexpr (has_closed_form_psi_v<G>) {
-    if (psi.method == Method::exact &&
-        G::ClosedFormPsi::angle(state.x) >= static_cast<Scalar>(kExactMinAngle)) {
+    if (psi.method == Method::exact && uses_closed_form_psi<G>(state.x)) {
       state.force = estimating_detail::closed_form_force<G>(observations, problem, g0, state.x,
                                                             residuals, workspace);
       return state;
