@@ -848,6 +848,34 @@ TEST_CASE("bireg_fit --confidence: an undefined covariance is a message and exit
   }
 }
 
+TEST_CASE("bireg_fit --output-band: too few degrees of freedom for the quantile is exit code 5",
+          "[tool][confidence]") {
+  // Five SE(3) poses: the homoscedastic covariance is defined with
+  // nu = N - 2 = 3 degrees of freedom, fewer than the 6 dimensions of the
+  // pose, so the Hotelling quantile of the band does not exist. That is an
+  // undefined statistic (5), not a write error (4): fuzz_bireg_fit found
+  // the tool reporting it as one.
+  std::istringstream source(slurp(data("se3_small.tum")));
+  std::string text, line;
+  for (int poses = 0; poses < 5 && std::getline(source, line);) {
+    text += line + '\n';
+    poses += line.rfind('#', 0) != 0;
+  }
+  const std::string file = scratch("five_poses.tum");
+  write_text(file, text);
+  const std::string band = scratch("five_poses_band.csv");
+  fs::remove(band);
+  const Run run = run_tool("--group SE3 --confidence 0.95 --output-band " + quoted(band) + " " +
+                           quoted(file));
+  CAPTURE(run.out, run.err);
+  REQUIRE(run.exit_code == 5);
+  REQUIRE(json_string(run.out, "status") == "converged");
+  REQUIRE(run.out.find("\"covariance_defined\": true") != std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(run.out));
+  REQUIRE_FALSE(fs::exists(band));
+  REQUIRE(run.err.find("not written: too few degrees of freedom") != std::string::npos);
+}
+
 TEST_CASE("bireg_fit refuses bad --confidence, --permutations and --seed", "[tool][confidence]") {
   const std::string file = quoted(data("so3_small.csv"));
   for (const std::string& args :

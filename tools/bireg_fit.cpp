@@ -79,6 +79,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/robust.hpp"
 #include "cli_common.hpp"
+#include "entry_points.hpp"
 #include "fit_auto.hpp"
 #include "fit_report.hpp"
 
@@ -281,12 +282,15 @@ int statistics(const Command& command,
       undefined = undefined || !defined;
     }
     if (!command.output_band.empty()) {
-      if (!covariances.defined()) {
+      std::string problem;
+      const std::optional<double> quantile =
+          bireg_fit_report::band_quantile(covariances, level, problem);
+      if (!quantile) {
         std::fprintf(stderr, "bireg_fit: %s: not written: %s\n", command.output_band.c_str(),
-                     covariances.problem.c_str());
+                     problem.c_str());
         undefined = true;
       } else if (auto error = bireg_fit_report::write_band(command.output_band, trajectory,
-                                                           covariances.homoscedastic, level)) {
+                                                           covariances.homoscedastic, *quantile)) {
         std::fprintf(stderr, "bireg_fit: %s\n", error->c_str());
         return kExitWriteError;
       }
@@ -461,7 +465,7 @@ int run(const Command& command) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bireg_cli::fit_main(int argc, char** argv) {
   Command command;
   if (const auto error = parse_command(argc, argv, command)) {
     std::fprintf(stderr, "bireg_fit: %s\n%s", error->c_str(), kUsage);

@@ -64,6 +64,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/local_regression.hpp"
 #include "cli_common.hpp"
+#include "entry_points.hpp"
 
 namespace {
 
@@ -370,7 +371,7 @@ int run(const Command& command) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int bireg_cli::smooth_main(int argc, char** argv) {
   Command command;
   if (const auto error = parse_command(argc, argv, command)) {
     std::fprintf(stderr, "bireg_smooth: %s\n%s", error->c_str(), kUsage);

@@ -198,19 +198,33 @@ std::string trend_test_json(const bireg::TrendTestResult<G>& test, int permutati
   return json + "}";
 }
 
+// The band's quantile at `level`, or why there is none: the covariance
+// is undefined, or it has too few degrees of freedom for the quantile.
+// Either is an undefined statistic (exit code 5), not a write error.
+template <class G>
+std::optional<double> band_quantile(const Covariances<G>& covariances, double level,
+                                    std::string& problem) {
+  if (!covariances.defined()) {
+    problem = covariances.problem;
+    return std::nullopt;
+  }
+  const std::optional<double> quantile = bireg::pose_quantile(covariances.homoscedastic, level);
+  if (!quantile) problem = "too few degrees of freedom for the band's quantile";
+  return quantile;
+}
+
 // Writes the band CSV: a header line, then per input observation (input
 // order) its timestamp as written in the input, the fitted pose's matrix
 // entries row by row, and the half-widths of the homoscedastic `level`
 // confidence ellipsoid of the pose projected on each tangent coordinate
 // (rotation in degrees, translation in the data's units, other
-// coordinates as they are). Returns "path: reason" on failure.
+// coordinates as they are), scaled by `quantile` (band_quantile's).
+// Returns "path: reason" when the file cannot be written.
 template <class G>
 std::optional<std::string> write_band(const std::string& path,
                                       const bireg::io::Trajectory<G>& trajectory,
-                                      const bireg::FitCovariance<G>& c, double level) {
+                                      const bireg::FitCovariance<G>& c, double quantile) {
   constexpr double kDegrees = 180.0 / 3.14159265358979323846;
-  const std::optional<double> quantile = bireg::pose_quantile(c, level);
-  if (!quantile) return path + ": too few degrees of freedom for the band's quantile";
   const std::vector<Coordinate> layout = coordinates<G>();
   const int side = bireg::io::matrix_side<G>();
   std::string text = "timestamp";
@@ -234,7 +248,7 @@ std::optional<std::string> write_band(const std::string& path,
         bireg::io::append_double(text, pose(r, k));
       }
     }
-    const auto widths = bireg::half_widths(bireg::pose_covariance(c, t), *quantile);
+    const auto widths = bireg::half_widths(bireg::pose_covariance(c, t), quantile);
     for (int k = 0; k < G::dof; ++k) {
       const bool degrees = layout[static_cast<std::size_t>(k)].kind == Kind::rotation;
       text += ',';

@@ -13,7 +13,8 @@
 //   * what they accept, written back in the format read, reads again to the
 //     same number of observations with the same timestamps;
 //   * fit() on parsed input never crashes, never returns NaN or infinity
-//     in its endpoints or diagnostics, and reports invalid input only with
+//     in its endpoints, diagnostics (the largest residual angle included)
+//     or residuals, and reports invalid input only with
 //     a message;
 //   * for SO3 and SE3 (the groups bireg_fit computes statistics for) and
 //     Sim3: the bi-invariant mean is finite when it succeeds; a defined
@@ -27,7 +28,7 @@
 // Build and run (clang):
 //   cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DBIREG_BUILD_FUZZERS=ON
 //   cmake --build build-fuzz --target fuzz_fit
-//   ./build-fuzz/tests/fuzz_fit -max_total_time=60 tests/fuzz/corpus
+//   ./build-fuzz/tests/fuzz_fit -max_total_time=60 -timeout=10 tests/fuzz/corpus_fuzz_fit
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -186,8 +187,9 @@ void exercise(const std::string& text, const bireg::io::ReadOptions& read_option
   }
   require(result.geodesic->start().allFinite() && result.geodesic->end().allFinite());
   const auto& d = result.diagnostics;
-  for (double x : {d.mu_min, d.mu_max, d.step_size, d.contraction_factor, d.force_norm,
-                   d.residual_rms, d.residual_rms_about_mean, d.explained_variance}) {
+  for (double x :
+       {d.mu_min, d.mu_max, d.step_size, d.contraction_factor, d.force_norm, d.residual_rms,
+        d.residual_rms_about_mean, d.explained_variance, d.largest_residual_angle}) {
     require(std::isfinite(x));
   }
   for (const auto& r : result.residuals)
