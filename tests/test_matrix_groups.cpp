@@ -265,6 +265,37 @@ TEMPLATE_TEST_CASE("matrix groups: hostile inputs give NaN, never a hang or an a
   }
 }
 
+// Found by fuzz_bireg_fit: two GL+(3) observations, one with entries 9e10
+// and 1e93 (determinant > 0, each log finite on its own). The residual of
+// one against the other cannot be computed in double, so the estimating
+// equations are not finite at any start. The fit used to report
+// `diverged` after 0 iterations with a non-finite force, residual RMS and
+// explained variance; it now refuses the data, naming the observation.
+TEST_CASE("GL+(3): data whose residuals double cannot compute are refused, not NaN",
+          "[matrix_group][errors]") {
+  using G = bireg::GLp<3, double>;
+  G::Element huge, moderate;
+  huge << 1.1967519434554703, 0.10848340422183004, 0.01583330414573588, -0.00349044317780999,
+      94274214889, 0.20396611242540016, 0.05399143513734126, 0.0320959019764489, 1e93;
+  moderate << 0.4124386583903679, -0.02333745909697053, 0.13477997402357375, 0.15375817461303468,
+      2.97497889436859, 0.2045456942787698, 0.07473029992205144, 0.03317811520773627,
+      1.6161007897712676;
+  REQUIRE(G::is_element(huge));
+  REQUIRE(G::is_element(moderate));
+  REQUIRE(G::log(huge).allFinite());
+  REQUIRE(G::log(moderate).allFinite());
+  const auto result = within_a_second([&] {
+    return bireg::GeodesicRegression<G>().fit(std::vector<G::Element>{huge, moderate},
+                                              std::vector<double>{0.0, 6.0});
+  });
+  CAPTURE(result.message);
+  REQUIRE(result.status == bireg::Status::invalid_input);
+  REQUIRE((result.bad_index == 0 || result.bad_index == 1));
+  REQUIRE(result.message.find("observation " + std::to_string(result.bad_index) +
+                              " is not finite at the start") != std::string::npos);
+  REQUIRE_FALSE(result.geodesic);
+}
+
 // The matrix functions in every precision: exp within a few epsilon of the
 // long double reference, log inverting it, for random general 3x3 matrices
 // (gl(3), eigenvalues up to size in modulus) of the sizes of the range test

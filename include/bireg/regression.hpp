@@ -104,6 +104,23 @@ class GeodesicRegression {
     return result;
   }
 
+  // The refusal of a start whose estimating equations are not finite,
+  // naming the first observation whose residual there is not.
+  static Rejection unevaluable_start(const std::vector<Tangent>& residuals) {
+    std::ptrdiff_t first_bad = -1;
+    for (std::size_t i = 0; i < residuals.size() && first_bad < 0; ++i) {
+      if (!residuals[i].allFinite()) first_bad = static_cast<std::ptrdiff_t>(i);
+    }
+    const std::string which = first_bad >= 0
+                                  ? "the residual of observation " + std::to_string(first_bad)
+                                  : std::string("the estimating equations");
+    return {which +
+                " is not finite at the start: the data span magnitudes that this scalar type "
+                "cannot invert and take the log of in " +
+                G::name,
+            first_bad};
+  }
+
   template <class Observations, class Covariates>
   Result run(const Observations& observations, const Covariates& covariates,
              const std::vector<Scalar>& weights, const Endpoints* start) const {
@@ -166,6 +183,14 @@ class GeodesicRegression {
       const State<G> state =
           iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
                      chart.reference, result.residuals, record, &workspace);
+      // The estimating equations are not finite at the start nor at the
+      // middle observation: some residual log(g(t_i)^{-1} f_i) cannot be
+      // computed in this scalar type (a matrix observation too
+      // ill-conditioned to invert and take the log of, next to the
+      // others). There is no iterate to report, and no finite diagnostic.
+      if (state.series_converges && !state.usable()) {
+        return rejected(unevaluable_start(result.residuals));
+      }
       if (!state.series_converges) {  // no force was evaluated there: residuals alone
         const Element g0_inverse = G::inverse(state.g0);
         for (std::size_t i = 0; i < n; ++i) {
