@@ -865,8 +865,8 @@ TEST_CASE("bireg_fit --output-band: too few degrees of freedom for the quantile 
   write_text(file, text);
   const std::string band = scratch("five_poses_band.csv");
   fs::remove(band);
-  const Run run = run_tool("--group SE3 --confidence 0.95 --output-band " + quoted(band) + " " +
-                           quoted(file));
+  const Run run =
+      run_tool("--group SE3 --confidence 0.95 --output-band " + quoted(band) + " " + quoted(file));
   CAPTURE(run.out, run.err);
   REQUIRE(run.exit_code == 5);
   REQUIRE(json_string(run.out, "status") == "converged");

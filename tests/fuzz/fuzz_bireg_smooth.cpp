@@ -47,25 +47,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   static const char* const kGroups[] = {"SO2", "SO3", "SE2", "SE3"};
   std::vector<std::string> args = {"bireg_smooth", "--group", kGroups[a & 3]};
-  switch ((a >> 2) & 7) {
-    case 1:
-      args.insert(args.end(), {"--format", "matrix"});
-      break;
-    case 2:
-      args.insert(args.end(), {"--format", "tum"});
-      break;
-    case 3:
-      args.insert(args.end(), {"--format", "euroc"});
-      break;
-    case 4:
-      args.insert(args.end(), {"--format", "kitti"});
-      break;
-    case 5:
-      args.insert(args.end(), {"--format", "kitti", "--times", input});
-      break;
-    default:  // detected from the content
-      break;
-  }
+  const std::vector<std::string> format = bireg_fuzz::format_options((a >> 2) & 7, input);
+  args.insert(args.end(), format.begin(), format.end());
   if (a & 32) args.push_back("--project");
   if (a & 64) args.insert(args.end(), {"--velocity", velocity});
   if (a & 128) args.insert(args.end(), {"--at", at});

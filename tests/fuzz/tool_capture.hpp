@@ -102,6 +102,17 @@ inline void require_messages(const std::string& err, const std::string& tool) {
   }
 }
 
+// The input-format options both tools take, from a 3-bit code: the
+// format detected from the content (0, 6, 7), matrix, tum, euroc, kitti,
+// or kitti with `input` itself as the --times file (5).
+inline std::vector<std::string> format_options(unsigned code, const std::string& input) {
+  static const char* const kFormats[] = {nullptr, "matrix", "tum", "euroc", "kitti", "kitti"};
+  if (code == 0 || code > 5) return {};
+  std::vector<std::string> options = {"--format", kFormats[code]};
+  if (code == 5) options.insert(options.end(), {"--times", input});
+  return options;
+}
+
 inline std::size_t count_lines(const std::string& text) {
   std::size_t lines = 0;
   for (char c : text)
