@@ -88,8 +88,6 @@ bool all_finite(const typename bireg::GeodesicRegression<G>::Result& result) {
          std::isfinite(result.diagnostics.explained_variance);
 }
 
-}  // namespace
-
 // ---------------------------------------------------------------------------
 // 2. Commutative exactness
 // ---------------------------------------------------------------------------
@@ -635,7 +633,6 @@ TEST_CASE("every solver converges to the same estimator", "[regression]") {
 
 // The iteration limit and a geodesic too long for the series are reported
 // in the status, with finite endpoints.
-namespace {
 // The universal cover of SE(2): the angle is a real number, not an angle
 // modulo 2 pi, so the logarithm is unbounded and ad_X can reach spectral
 // radius 2 pi. Only a test group: it shows what the regression does when a

@@ -37,14 +37,7 @@ namespace {
 using R3 = bireg::Rn<3>;
 using Matrix2 = Eigen::Matrix2d;
 
-template <class Tangent>
-Tangent normal_tangent(std::mt19937& rng, double sd) {
-  std::normal_distribution<double> normal(0.0, sd);
-  Tangent x;
-  for (int i = 0; i < x.size(); ++i)
-    x[i] = normal(rng);
-  return x;
-}
+using bireg_test::normal_tangent;
 
 template <class G>
 struct Data {

@@ -20,14 +20,7 @@
 
 namespace {
 
-template <class Tangent>
-Tangent normal_tangent(std::mt19937& rng, double sd) {
-  std::normal_distribution<double> normal(0.0, sd);
-  Tangent x;
-  for (int i = 0; i < x.size(); ++i)
-    x[i] = normal(rng);
-  return x;
-}
+using bireg_test::normal_tangent;
 
 struct Coverage {
   int endpoints = 0, velocity = 0, replicates = 0;

@@ -19,6 +19,16 @@ constexpr Scalar eps() {
   return std::numeric_limits<Scalar>::epsilon();
 }
 
+// A tangent vector with independent N(0, sd^2) coordinates.
+template <class Tangent>
+Tangent normal_tangent(std::mt19937& rng, double sd) {
+  std::normal_distribution<double> normal(0.0, sd);
+  Tangent x;
+  for (int i = 0; i < x.size(); ++i)
+    x[i] = normal(rng);
+  return x;
+}
+
 // A random unit vector of dimension D.
 template <int D>
 Eigen::Matrix<long double, D, 1> random_unit(std::mt19937& rng) {

@@ -143,7 +143,7 @@ MUTANTS = [
            "if (errno == ERANGE && std::abs(value) < 1.0) {",
            ["test_io"],
            "range check inverted: underflow refused, overflow not named"),
-    Mutant("CL1", "tools/bireg_fit.cpp",
+    Mutant("CL1", "tools/fit_run.hpp",
            "if (!result.ok() || (robust && !robust->ok())) return kExitNotConverged;",
            "if (!result.ok() && (robust && !robust->ok())) return kExitNotConverged;",
            ["test_fit_tool"],
