@@ -1,7 +1,8 @@
 // MatrixGroup<N, Basis>: the algebraic identities of test_groups.cpp on the
 // Heisenberg group, SL(3) and GL+(3), the Heisenberg group's polynomial
 // closed forms and terminating series, exp/log from tiny to near the branch
-// cut, and the log's domain (the regression on them: test_scene_groups.cpp).
+// cut, and the log's domain (the regression on them: test_scene_groups.cpp
+// for the Heisenberg group, test_scene_groups_matrix.cpp for SL(3), GL+(3)).
 //
 // Tolerance: the matrix exponential (Pade with scaling and squaring) and
 // logarithm (inverse scaling and squaring) of bireg/math/matrix_functions.hpp
