@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -174,4 +175,81 @@ TEST_CASE("a long Sim(3) fit by the closed form matches the series", "[exact]") 
   REQUIRE(series.diagnostics.series_order > 30);
   REQUIRE((closed.geodesic->start() - series.geodesic->start()).norm() < 1e-9);
   REQUIRE((closed.geodesic->end() - series.geodesic->end()).norm() < 1e-9);
+}
+
+// psi_closed_form::half_angle_pair derives one of the sin/cos pairs by the
+// angle-difference formulas. Bound, for theta in (0, pi]: each of sin and cos
+// of theta/2 and of the smaller angle a carries at most 1 ulp (u = epsilon),
+// so each product carries 3u; the difference loses at most the factor
+// (|T1| + |T2|) / |T1 - T2| <= 3 (math/psi_closed_form.hpp), 9u, plus u for
+// its own rounding and u for the rounding of the angle a itself: 11u
+// relative for the sines. The cosines are checked in absolute terms: near
+// theta = pi, cos((1 - s) theta/2) -> 0 has condition number ~ 1/s in the
+// angle, so no evaluation from rounded angles, this one or a direct one, is
+// relatively accurate there (the closed forms use the cosines only as
+// factors, where absolute accuracy is what counts). Checked against long
+// double at s down to 1e-8 and up to 1 - 1e-8, where deriving the small
+// angle instead would lose the relative accuracy of its sine.
+TEST_CASE("the derived half-angle pair keeps the accuracy of both angles", "[exact]") {
+  using bireg::psi_closed_form::half_angle_pair;
+  using SinCos = bireg::psi_closed_form::SinCos<double>;
+  const double bound = 11 * std::numeric_limits<double>::epsilon();
+  const auto error = [](double value, long double reference, long double scale) {
+    return static_cast<double>(std::abs(static_cast<long double>(value) - reference) / scale);
+  };
+  double worst = 0;
+  for (double theta : angles()) {
+    if (theta < 1e-3) continue;  // the closed forms start at kExactMinAngle
+    for (double s : {1e-8, 1e-3, 0.1, 0.25, 0.4999, 0.5, 0.5001, 0.75, 0.9, 1 - 1e-3, 1 - 1e-8}) {
+      const auto pair = half_angle_pair(theta, SinCos::of(theta / 2), s);
+      const long double half = static_cast<long double>(theta) / 2;
+      const long double s_angle = static_cast<long double>(s) * half;
+      const long double u_angle = (1.0L - static_cast<long double>(s)) * half;
+      const long double s_sin = std::sin(s_angle), u_sin = std::sin(u_angle);
+      CAPTURE(theta, s);
+      for (const double e :
+           {error(pair.s_half.sin, s_sin, s_sin), error(pair.u_half.sin, u_sin, u_sin),
+            error(pair.s_half.cos, std::cos(s_angle), 1),
+            error(pair.u_half.cos, std::cos(u_angle), 1)}) {
+        REQUIRE(e <= bound);
+        worst = std::max(worst, e);
+      }
+    }
+  }
+  // The loss factor is real: the worst case is above one ulp.
+  CHECK(worst > std::numeric_limits<double>::epsilon());
+}
+
+// ClosedFormPsi::exp(prepared, t, t_half) builds exp(t x) from the force's
+// half-angle pair instead of the angle |t omega|: the same Rodrigues and
+// translation coefficients, rounded differently. Bound: the pair's 11
+// epsilon (above) and 3 more from the coefficients' products, on entries
+// up to 2 (b |omega|^2 <= 2), plus G::exp's own few ulps: 32 epsilon in
+// max-norm (translations here are of order 1).
+TEST_CASE("exp along x from the half-angle pair matches the group's exp", "[exact]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uniform(-1, 1);
+  const double bound = 32 * std::numeric_limits<double>::epsilon();
+  const auto check = [&](auto group) {
+    using G = decltype(group);
+    using Psi = typename G::ClosedFormPsi;
+    for (double angle : angles()) {
+      if (angle < bireg::kExactMinAngle) continue;
+      typename G::Tangent x;
+      for (int k = 0; k < G::dof; ++k)
+        x[k] = uniform(rng);
+      x.template tail<3>() *= angle / x.template tail<3>().norm();
+      const auto prepared = Psi::prepare(x);
+      for (double t : {0.0, 1e-8, 0.3, 0.5, 0.7, 1 - 1e-8, 1.0}) {
+        const auto pair = bireg::psi_closed_form::half_angle_pair(
+            prepared.theta, Psi::SinCos::of(prepared.theta / 2), t);
+        const typename G::Element shared = Psi::exp(prepared, t, pair.s_half);
+        const typename G::Element direct = G::exp(t * x);
+        CAPTURE(G::name, angle, t);
+        REQUIRE((shared - direct).cwiseAbs().maxCoeff() <= bound);
+      }
+    }
+  };
+  check(bireg::SO3<double>{});
+  check(bireg::SE3<double>{});
 }

@@ -22,7 +22,11 @@
 //       observation (statistics/covariance.hpp).
 //   struct ClosedFormPsi                             psi_s(ad_x) r in closed form
 //       (see math/psi_closed_form.hpp and SO3::ClosedFormPsi for the
-//       interface) fallback: the power series of math/psi_series.hpp.
+//       interface; with kTerms, coefficients and combine where it is a sum
+//       of scalar coefficients times fixed maps, which the force then sums
+//       per coefficient, and exp(prepared, t, t_half) where exp(t x) can
+//       reuse the force's half-angle sin and cos) fallback: the power series
+//       of math/psi_series.hpp.
 //
 // J_r is the right Jacobian of exp: exp(x + dx) = exp(x) exp(J_r(x) dx +
 // O(dx^2)), with left-trivialised perturbations as everywhere in bireg.
@@ -68,6 +72,11 @@ template <class G>
 using closed_form_psi = typename G::ClosedFormPsi;
 template <class Psi>
 using closed_form_min_angle = decltype(Psi::kMinAngle);
+template <class Psi>
+using closed_form_terms = decltype(Psi::kTerms);
+template <class Psi>
+using closed_form_exp = decltype(Psi::exp(std::declval<const typename Psi::Prepared&>(), 0.0,
+                                          std::declval<const typename Psi::SinCos&>()));
 }  // namespace capability_detail
 
 // J_r(x) and its inverse at one x.

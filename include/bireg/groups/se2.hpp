@@ -9,6 +9,7 @@
 // both free of cancellation (small_angle.hpp).
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -122,41 +123,47 @@ struct SE2 {
     return orthonormality <= tol && abs(r.determinant() - Scalar(1)) <= tol && last_row <= tol;
   }
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
-  // "Exact form"): the rotation part as on SO(2) rotated by F(i theta), the
-  // angle's column mapped by f1 I + theta f2 J. Angle at least kExactMinAngle.
+  // "Exact form"): the rotation part as on SO(2) rotated by F(i theta) =
+  // (s - theta^2 f2) + i theta f1, the angle's column c = -J rho mapped by
+  // f1 I + theta f2 J; i.e. the coefficients (s, f1, f2) of the maps
+  //   I,   [theta J, c; 0, 0],   [-theta^2 I, theta J c; 0, 0]
+  // (F(-i theta) = conj F(i theta): the coefficients at |theta|, the sign
+  // carried by the signed angle). Angle at least kExactMinAngle.
   struct ClosedFormPsi {
     using SinCos = psi_closed_form::SinCos<Scalar>;
     struct Prepared {
       Tangent x;
       Scalar theta;  // |theta|; the sign is carried by x[2]
-      SinCos half;
+      psi_closed_form::Angle<Scalar> angle;
     };
+    static constexpr int kTerms = 3;
     static Scalar angle(const Tangent& x) {
       using std::abs;
       return abs(x[2]);
     }
     static Prepared prepare(const Tangent& x) {
       using std::abs;
-      return {x, abs(x[2]), SinCos::of(abs(x[2]) / 2)};
+      return {x, abs(x[2]), psi_closed_form::Angle<Scalar>::of(abs(x[2]))};
+    }
+    static std::array<Scalar, kTerms> coefficients(const Prepared& p, Scalar s,
+                                                   const SinCos& s_half, const SinCos& u_half) {
+      return psi_closed_form::rotation_block_coefficients(p.angle, s, s_half, u_half);
+    }
+    static Tangent combine(const Prepared& p, const std::array<Tangent, kTerms>& sums) {
+      const Scalar theta = p.x[2];
+      const Scalar cx = p.x[1], cy = -p.x[0];  // c = -J rho
+      const Tangent& a = sums[0];
+      const Tangent& b = sums[1];
+      const Tangent& d = sums[2];
+      Tangent out;
+      out[0] = a[0] - theta * b[1] + cx * b[2] - theta * theta * d[0] - theta * cy * d[2];
+      out[1] = a[1] + theta * b[0] + cy * b[2] - theta * theta * d[1] + theta * cx * d[2];
+      out[2] = a[2];
+      return out;
     }
     static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
                          const Tangent& r) {
-      if (s == 0) return Tangent::Zero();
-      // F(-i theta) = conj F(i theta): the coefficients at |theta|, the sign
-      // carried by the signed angle.
-      const auto c =
-          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
-      const Scalar theta = p.x[2];
-      const Scalar re = s - theta * theta * c.f2;  // Re F(i theta)
-      const Scalar im = theta * c.f1;              // Im F(i theta), odd in theta
-      // The angle's ad column is c = -J rho; the block maps it by f1 I + theta f2 J.
-      const Scalar cx = p.x[1], cy = -p.x[0];
-      const Scalar lx = c.f1 * cx - theta * c.f2 * cy, ly = c.f1 * cy + theta * c.f2 * cx;
-      Tangent out;
-      out[0] = re * r[0] - im * r[1] + lx * r[2];
-      out[1] = im * r[0] + re * r[1] + ly * r[2];
-      out[2] = s * r[2];
-      return out;
+      return psi_closed_form::apply_by_coefficients<ClosedFormPsi>(p, s, s_half, u_half, r);
     }
   };
 };

@@ -11,6 +11,7 @@
 // without cancellation (small_angle.hpp); V is applied with cross products.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -68,11 +69,10 @@ struct SE3 {
 
   // Principal logarithm: |omega| in [0, pi].
   static Tangent log(const Element& g) {
-    using std::sqrt;
     const Vector3 omega = Rotation::log(g.template topLeftCorner<3, 3>());
     const Vector3 t = g.template topRightCorner<3, 1>();
-    const Scalar theta = sqrt(omega.squaredNorm());
-    const Scalar e = small_angle::one_minus_half_x_cot_half_x_over_x2(theta);
+    const Scalar e =
+        small_angle::one_minus_half_x_cot_half_x_over_x2_from_square(omega.squaredNorm());
     const Vector3 w_t = omega.cross(t);
     Tangent xi;
     xi.template head<3>() = t - w_t / Scalar(2) + e * omega.cross(w_t);
@@ -168,38 +168,71 @@ struct SE3 {
 
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
   // "Exact form"): the diagonal blocks as on SO(3), the upper-right block the
-  // derivative of F(W) along P = hat(rho). Angle at least kExactMinAngle.
+  // derivative of F(W) along P = hat(rho),
+  //   F(ad_x) = s I + f1 ad_x + f2 [W^2, W P + P W; 0, W^2]
+  //             + (omega . rho) (g1 [0, W; 0, 0] + g2 [0, W^2; 0, 0]),
+  // i.e. five coefficients of five maps. Angle at least kExactMinAngle.
   struct ClosedFormPsi {
     using SinCos = psi_closed_form::SinCos<Scalar>;
     struct Prepared {
       Vector3 rho, omega;
       Scalar theta, omega_dot_rho;
-      SinCos half;
+      psi_closed_form::Angle<Scalar> angle;
+      Vector3 w_rho, w_w_rho;  // W rho, W^2 rho (for exp)
     };
+    static constexpr int kTerms = 5;
     static Scalar angle(const Tangent& x) { return x.template tail<3>().norm(); }
     static Prepared prepare(const Tangent& x) {
       const Vector3 rho = x.template head<3>(), omega = x.template tail<3>();
       const Scalar theta = omega.norm();
-      return {rho, omega, theta, omega.dot(rho), SinCos::of(theta / 2)};
+      const Vector3 w_rho = omega.cross(rho);
+      return {rho,
+              omega,
+              theta,
+              omega.dot(rho),
+              psi_closed_form::Angle<Scalar>::of(theta),
+              w_rho,
+              omega.cross(w_rho)};
+    }
+    static std::array<Scalar, kTerms> coefficients(const Prepared& p, Scalar s,
+                                                   const SinCos& s_half, const SinCos& u_half) {
+      if (s == 0) return {0, 0, 0, 0, 0};
+      const auto c = psi_closed_form::psi_coefficients<Scalar>(p.angle, s, s_half, u_half);
+      return {s, c.f1, c.f2, p.omega_dot_rho * c.g1, p.omega_dot_rho * c.g2};
+    }
+    // sum_k B_k sums[k]: on (a_k, b_k) = (rho, omega) parts of sums[k],
+    //   omega part: b0 + W (b1 + W b2),
+    //   rho part:   a0 + P b1 + W (a1 + b3 + W (a2 + b4) + P b2) + P W b2.
+    static Tangent combine(const Prepared& p, const std::array<Tangent, kTerms>& sums) {
+      const auto rho_part = [&](int k) { return sums[k].template head<3>(); };
+      const auto omega_part = [&](int k) { return sums[k].template tail<3>(); };
+      const Vector3 w_b2 = p.omega.cross(omega_part(2));
+      const Vector3 inner = rho_part(1) + omega_part(3) +
+                            p.omega.cross(rho_part(2) + omega_part(4)) + p.rho.cross(omega_part(2));
+      Tangent out;
+      out.template head<3>() =
+          rho_part(0) + p.rho.cross(omega_part(1)) + p.omega.cross(inner) + p.rho.cross(w_b2);
+      out.template tail<3>() = omega_part(0) + p.omega.cross(omega_part(1) + w_b2);
+      return out;
+    }
+    // exp(t x), t >= 0, from sin and cos of t theta/2 (the force's half-angle
+    // pair), as SE3::exp with the angle t theta: on the unscaled omega and
+    // rho the coefficients are a = sin(t theta)/theta, b = (1 - cos(t
+    // theta))/theta^2 (from the half angle, see SO3::ClosedFormPsi::exp) and
+    // c = t^3 (u - sin u)/u^3 at u = t theta, so that
+    // exp(t x) = [I + a W + b W^2,  t rho + b W rho + c W^2 rho].
+    static Element exp(const Prepared& p, Scalar t, const SinCos& t_half) {
+      const Scalar a = 2 * t_half.sin * t_half.cos * p.angle.inverse;
+      const Scalar b = 2 * t_half.sin * t_half.sin * p.angle.inverse2;
+      const Scalar c = t * t * t * small_angle::x_minus_sin_over_x3(t * p.theta);
+      Element g = Element::Identity();
+      g.template topLeftCorner<3, 3>() = Rotation::rodrigues(p.omega, a, b);
+      g.template topRightCorner<3, 1>() = t * p.rho + b * p.w_rho + c * p.w_w_rho;
+      return g;
     }
     static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
                          const Tangent& r) {
-      if (s == 0) return Tangent::Zero();
-      const auto c =
-          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
-      const Vector3 r_rho = r.template head<3>(), r_omega = r.template tail<3>();
-      const auto rotation_block = [&](const Vector3& v) {
-        const Vector3 w_v = p.omega.cross(v);
-        return Vector3(s * v + c.f1 * w_v + c.f2 * p.omega.cross(w_v));
-      };
-      const Vector3 w_v = p.omega.cross(r_omega);
-      const Vector3 p_v = p.rho.cross(r_omega);
-      const Vector3 derivative = c.f1 * p_v + c.f2 * (p.omega.cross(p_v) + p.rho.cross(w_v)) +
-                                 p.omega_dot_rho * (c.g1 * w_v + c.g2 * p.omega.cross(w_v));
-      Tangent out;
-      out.template head<3>() = rotation_block(r_rho) + derivative;
-      out.template tail<3>() = rotation_block(r_omega);
-      return out;
+      return psi_closed_form::apply_by_coefficients<ClosedFormPsi>(p, s, s_half, u_half, r);
     }
   };
 

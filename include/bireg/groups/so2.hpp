@@ -5,6 +5,7 @@
 // SO(2) is least squares on the unwrapped angle.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -66,18 +67,25 @@ struct SO2 {
     return orthonormality <= tol && abs(g.determinant() - Scalar(1)) <= tol;
   }
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
-  // "Exact form"): SO(2) is commutative, ad = 0, so psi_s(0) = s.
+  // "Exact form"): SO(2) is commutative, ad = 0, so psi_s(0) = s, one term.
   struct ClosedFormPsi {
     using SinCos = psi_closed_form::SinCos<Scalar>;
     struct Prepared {
       Scalar theta = 0;
-      SinCos half{0, 1};
     };
+    static constexpr int kTerms = 1;
     static Scalar angle(const Tangent&) { return Scalar(kExactMinAngle); }  // ad = 0: always exact
     static Prepared prepare(const Tangent&) { return {}; }
-    static Tangent apply(const Prepared&, Scalar s, const SinCos&, const SinCos&,
+    static std::array<Scalar, kTerms> coefficients(const Prepared&, Scalar s, const SinCos&,
+                                                   const SinCos&) {
+      return {s};
+    }
+    static Tangent combine(const Prepared&, const std::array<Tangent, kTerms>& sums) {
+      return sums[0];
+    }
+    static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
                          const Tangent& r) {
-      return s * r;
+      return psi_closed_form::apply_by_coefficients<ClosedFormPsi>(p, s, s_half, u_half, r);
     }
   };
 };

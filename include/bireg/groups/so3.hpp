@@ -12,6 +12,7 @@
 // theta -> 0 and theta -> pi, and tolerates inputs slightly off the group.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include <Eigen/Core>
@@ -125,12 +126,26 @@ struct SO3 {
 
   // Principal logarithm: |omega| in [0, pi]. At exactly pi both +-omega are
   // logarithms; the one with the sign of the chosen quaternion is returned.
+  // Below pi/2 from the antisymmetric part of r (first branch); otherwise
   // omega = (theta / |v|) v with theta = 2 atan2(|v|, w). For w > |v|
   // (angles below pi/2) theta/|v| = (2/w) atan(y)/y with y = |v|/w, whose
   // series covers |v| -> 0 without forming |v| (no underflow at 1e-300).
   static Tangent log(const Element& r) {
     using std::atan2;
     using std::sqrt;
+    const Scalar trace = r(0, 0) + r(1, 1) + r(2, 2);
+    if (trace > Scalar(1)) {
+      // Angle below pi/2 (trace = 1 + 2 cos theta): the antisymmetric part
+      // d = 2 sin(theta) axis has no cancellation, 1 + trace = 4 cos^2(theta/2)
+      // >= 2, y = |d| / (1 + trace) = tan(theta/2), and
+      // omega = theta d / |d| = (2 / (1 + trace)) (atan(y) / y) d: the
+      // quaternion route's w > |v| branch below in fewer dependent steps
+      // (no square root of 1 + trace, no division by w).
+      const Tangent d(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));
+      const Scalar one_plus_trace = Scalar(1) + trace;
+      const Scalar y = sqrt(d.squaredNorm()) / one_plus_trace;
+      return (Scalar(2) / one_plus_trace * small_angle::atan_over_y(y)) * d;
+    }
     const Quaternion q = to_quaternion(r);
     const Scalar w = q.w();
     const Tangent v = q.vec();
@@ -212,27 +227,40 @@ struct SO3 {
     return orthonormality <= tol && abs(r.determinant() - Scalar(1)) <= tol;
   }
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
-  // "Exact form"): F(W) v = s v + f1 W v + f2 W^2 v, W = hat(omega). apply()
-  // needs the angle at least kExactMinAngle; the regression uses the series below.
+  // "Exact form"): F(W) v = s v + f1 W v + f2 W^2 v, W = hat(omega), i.e. the
+  // coefficients (s, f1, f2) of the maps (I, W, W^2). The angle must be at
+  // least kExactMinAngle; the regression uses the series below.
   struct ClosedFormPsi {
     using SinCos = psi_closed_form::SinCos<Scalar>;
     struct Prepared {
       Tangent omega;
       Scalar theta;
-      SinCos half;
+      psi_closed_form::Angle<Scalar> angle;
     };
+    static constexpr int kTerms = 3;
     static Scalar angle(const Tangent& x) { return x.norm(); }
     static Prepared prepare(const Tangent& x) {
       const Scalar theta = x.norm();
-      return {x, theta, SinCos::of(theta / 2)};
+      return {x, theta, psi_closed_form::Angle<Scalar>::of(theta)};
+    }
+    static std::array<Scalar, kTerms> coefficients(const Prepared& p, Scalar s,
+                                                   const SinCos& s_half, const SinCos& u_half) {
+      return psi_closed_form::rotation_block_coefficients(p.angle, s, s_half, u_half);
+    }
+    static Tangent combine(const Prepared& p, const std::array<Tangent, kTerms>& sums) {
+      return sums[0] + p.omega.cross(sums[1] + p.omega.cross(sums[2]));
+    }
+    // exp(t x), t >= 0, from sin and cos of t theta/2 (the force's half-angle
+    // pair): on the unscaled omega, Rodrigues' coefficients are
+    // sin(t theta)/theta = 2 sin cos / theta and (1 - cos(t theta))/theta^2 =
+    // 2 sin^2 / theta^2, free of cancellation and exact at t = 0.
+    static Element exp(const Prepared& p, Scalar, const SinCos& t_half) {
+      return rodrigues(p.omega, 2 * t_half.sin * t_half.cos * p.angle.inverse,
+                       2 * t_half.sin * t_half.sin * p.angle.inverse2);
     }
     static Tangent apply(const Prepared& p, Scalar s, const SinCos& s_half, const SinCos& u_half,
                          const Tangent& r) {
-      if (s == 0) return Tangent::Zero();
-      const auto c =
-          psi_closed_form::psi_coefficients<Scalar>({p.theta, p.half, s_half, u_half}, s);
-      const Tangent w_r = p.omega.cross(r);
-      return s * r + c.f1 * w_r + c.f2 * p.omega.cross(w_r);
+      return psi_closed_form::apply_by_coefficients<ClosedFormPsi>(p, s, s_half, u_half, r);
     }
   };
 };

@@ -22,6 +22,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
+#include "bireg/groups/capabilities.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/psi_series.hpp"
 #include "bireg/regression/parallel.hpp"
@@ -179,8 +180,13 @@ Force<G> series_force(const Observations& observations, const Problem<typename G
 }
 
 // The closed form: psi_s(-A) is psi_s of ad_{-X}. Both directions use the
-// angles t theta/2 and (1 - t) theta/2 with their roles swapped: per
-// observation, the residual, two sin/cos pairs and two closed forms.
+// angles t theta/2 and (1 - t) theta/2 with their roles swapped, one sin/cos
+// pair evaluated per observation and the other derived from it
+// (psi_closed_form::half_angle_pair). Where G's closed form is a sum of
+// coefficients times fixed maps (ClosedFormPsi::kTerms; not Sim(3)), the
+// weighted residuals are summed per coefficient and the maps applied once
+// per chunk (psi_closed_form::apply_by_coefficients); otherwise each
+// observation's psi_s r is evaluated.
 template <class G, class Observations>
 Force<G> closed_form_force(const Observations& observations,
                            const Problem<typename G::Scalar>& problem,
@@ -193,20 +199,54 @@ Force<G> closed_form_force(const Observations& observations,
   using SinCos = psi_closed_form::SinCos<Scalar>;
   const auto forward = Psi::prepare(x);
   const auto backward = Psi::prepare(-x);
+  const Scalar theta = forward.theta;
+  const SinCos half = SinCos::of(theta / 2);
   const typename G::Element g0_inverse = G::inverse(g0);
+  // The residual r_i (see residual()), with exp(-t x) from the half-angle
+  // pair where G's closed form provides it.
+  const auto residual_at = [&](std::size_t i, Scalar t, const SinCos& t_half) {
+    if constexpr (provides_v<Psi, capability_detail::closed_form_exp>) {
+      return G::log(
+          G::compose(Psi::exp(backward, t, t_half), G::compose(g0_inverse, observations[i])));
+    } else {
+      static_cast<void>(t_half);
+      return residual<G>(g0_inverse, x, t, observations[i]);
+    }
+  };
   // The force of observations [begin, end), from zero.
   const auto accumulate = [&](std::size_t begin, std::size_t end) {
-    Force<G> force{Tangent::Zero(), Tangent::Zero()};
-    for (std::size_t i = begin; i < end; ++i) {
-      const Scalar t = problem.t[i], w = problem.w[i];
-      const Tangent r = residual<G>(g0_inverse, x, t, observations[i]);
-      residuals[i] = r;
-      const SinCos t_half = SinCos::of(t * forward.theta / 2);
-      const SinCos u_half = SinCos::of((1 - t) * forward.theta / 2);
-      force.v0 += w * Psi::apply(backward, 1 - t, u_half, t_half, r);
-      force.v1 += w * Psi::apply(forward, t, t_half, u_half, r);
+    if constexpr (provides_v<Psi, capability_detail::closed_form_terms>) {
+      // sums[k] = sum_i w_i c_k(s_i) r_i for each direction.
+      std::array<Tangent, Psi::kTerms> v0_sums, v1_sums;
+      for (int k = 0; k < Psi::kTerms; ++k) {
+        v0_sums[k].setZero();
+        v1_sums[k].setZero();
+      }
+      for (std::size_t i = begin; i < end; ++i) {
+        const Scalar t = problem.t[i], w = problem.w[i];
+        const auto angles = psi_closed_form::half_angle_pair(theta, half, t);
+        const Tangent r = residual_at(i, t, angles.s_half);
+        residuals[i] = r;
+        const auto c0 = Psi::coefficients(backward, 1 - t, angles.u_half, angles.s_half);
+        const auto c1 = Psi::coefficients(forward, t, angles.s_half, angles.u_half);
+        for (int k = 0; k < Psi::kTerms; ++k) {
+          v0_sums[k] += (w * c0[k]) * r;
+          v1_sums[k] += (w * c1[k]) * r;
+        }
+      }
+      return Force<G>{Psi::combine(backward, v0_sums), Psi::combine(forward, v1_sums)};
+    } else {
+      Force<G> force{Tangent::Zero(), Tangent::Zero()};
+      for (std::size_t i = begin; i < end; ++i) {
+        const Scalar t = problem.t[i], w = problem.w[i];
+        const auto angles = psi_closed_form::half_angle_pair(theta, half, t);
+        const Tangent r = residual_at(i, t, angles.s_half);
+        residuals[i] = r;
+        force.v0 += w * Psi::apply(backward, 1 - t, angles.u_half, angles.s_half, r);
+        force.v1 += w * Psi::apply(forward, t, angles.s_half, angles.u_half, r);
+      }
+      return force;
     }
-    return force;
   };
   const std::size_t n = observations.size();
   const std::size_t chunks = chunk_count(n);
