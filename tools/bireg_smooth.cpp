@@ -247,17 +247,10 @@ template <class G>
 int run(const Command& command) {
   namespace io = bireg::io;
   const std::string name = bireg_cli::display_name(command.input.path);
-  if (command.output_format) {
-    if (auto problem =
-            bireg_cli::output_format_problem<G>(command.output_format, io::Format::matrix))
-      return fail(*problem);
-  }
   io::Trajectory<G> trajectory;
-  if (auto error = bireg_cli::read_input<G>(command.input, trajectory)) return fail(*error);
-  if (!command.output.empty()) {
-    if (auto problem =
-            bireg_cli::output_format_problem<G>(command.output_format, trajectory.format))
-      return fail(name + ": " + *problem);
+  if (auto problem = bireg_cli::read_input_for_output<G>(command.input, command.output_format,
+                                                         !command.output.empty(), trajectory)) {
+    return fail(*problem);
   }
   const io::TimeUnit unit = io::time_unit(trajectory.format);
   // The same refusals, in the same words, as bireg_fit's.

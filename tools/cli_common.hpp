@@ -162,6 +162,30 @@ std::optional<std::string> output_format_problem(std::optional<bireg::io::Format
          (requested ? "" : " (the input's format; use --output-format matrix)");
 }
 
+// read_input with the output-format checks of a tool that may write a
+// trajectory around it: an explicit `output_format` is checked before the
+// input is read (it does not depend on it), the default one (the input's
+// format) after, and only when an output trajectory was asked for
+// (`writes_trajectory`). Returns the one-line message of the first problem.
+template <class G>
+std::optional<std::string> read_input_for_output(const InputOptions& input,
+                                                 std::optional<bireg::io::Format> output_format,
+                                                 bool writes_trajectory,
+                                                 bireg::io::Trajectory<G>& trajectory) {
+  if (output_format) {
+    if (auto problem = output_format_problem<G>(output_format, bireg::io::Format::matrix)) {
+      return problem;
+    }
+  }
+  if (auto error = read_input<G>(input, trajectory)) return error;
+  if (writes_trajectory) {
+    if (auto problem = output_format_problem<G>(output_format, trajectory.format)) {
+      return display_name(input.path) + ": " + *problem;
+    }
+  }
+  return std::nullopt;
+}
+
 // Writes `poses` at `timestamps` to `path` ("-": standard output) in
 // `format`, timestamps rendered as the `source` format wrote them. Returns
 // "path: reason" when the file cannot be written.

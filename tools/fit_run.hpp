@@ -95,18 +95,10 @@ int run(const FitCommand& command) {
   using Regression = bireg::GeodesicRegression<G>;
   namespace io = bireg::io;
   const std::string name = bireg_cli::display_name(command.input.path);
-  if (command.output_format) {
-    if (auto problem =
-            bireg_cli::output_format_problem<G>(command.output_format, io::Format::matrix))
-      return fail(*problem);
-  }
-
   io::Trajectory<G> trajectory;
-  if (auto error = bireg_cli::read_input<G>(command.input, trajectory)) return fail(*error);
-  if (!command.output_trajectory.empty()) {
-    if (auto problem =
-            bireg_cli::output_format_problem<G>(command.output_format, trajectory.format))
-      return fail(name + ": " + *problem);
+  if (auto problem = bireg_cli::read_input_for_output<G>(
+          command.input, command.output_format, !command.output_trajectory.empty(), trajectory)) {
+    return fail(*problem);
   }
 
   typename Regression::Options options;
