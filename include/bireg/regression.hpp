@@ -139,7 +139,8 @@ class GeodesicRegression {
     // The pool lives as long as this fit and serves every pass over the
     // observations (parallel.hpp); below kParallelMinimum there is none.
     std::optional<ChunkPool> pool;
-    if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads);
+    if (options_.threads > 1 && n >= kParallelMinimum)
+      pool.emplace(options_.threads, chunk_count(n));
     ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
     if (auto rejection =
             check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {

@@ -55,8 +55,11 @@ struct RegressionOptions {
   // Threads for the passes over the observations (parallel.hpp: the check,
   // the chart start, the Gauss-Newton moments, the force, the diagnostics),
   // at least 1. A fit of kParallelMinimum observations or more starts
-  // threads - 1 workers for its duration; the results are bit-identical
-  // for any value. 1 (the default): no thread is ever started.
+  // threads - 1 workers for its duration, capped at one fewer than its
+  // chunks (chunk_count(n)) and at kMaxWorkers (255: so at most kMaxThreads
+  // = 256 threads work, whatever is asked); a worker the system refuses to
+  // start leaves fewer, never an error. The results are bit-identical for
+  // any value. 1 (the default): no thread is ever started.
   int threads = 1;
 
   // How the estimating equations evaluate psi, from the fields above.

@@ -9,13 +9,25 @@
 // ChunkPool starts threads - 1 workers once (per fit) and reuses them for
 // every sum; the calling thread works too. A run publishes a function
 // pointer and a context (no std::function, no allocation per run).
+//
+// Workers are bounded: never more than the tasks a pool is told it will
+// run (the chunks of a fit, the candidates of a selection) minus one, and
+// never more than kMaxWorkers, whatever `threads` asks for. A worker the
+// system refuses to start (std::thread throws std::system_error under
+// RLIMIT_NPROC, or std::bad_alloc when memory is short) is not an error:
+// the pool keeps the workers it has (possibly none) and the calling thread
+// does the rest. Since the arithmetic does not depend on which thread
+// computes a chunk, the results are the same bit for bit.
 #pragma once
 
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <limits>
 #include <mutex>
+#include <new>
+#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -33,13 +45,44 @@ inline std::size_t chunk_count(std::size_t n) {
   return (n + kChunkSize - 1) / kChunkSize;
 }
 
+// At most this many workers per pool (kMaxThreads threads with the calling
+// one): far more than a machine's cores, far fewer than would exhaust its
+// memory or its process limit (each worker reserves a stack).
+inline constexpr std::size_t kMaxWorkers = 255;
+inline constexpr int kMaxThreads = static_cast<int>(kMaxWorkers) + 1;
+
+namespace parallel_detail {
+// Test seam: when set, called before worker k (0-based) of a pool starts;
+// returning true makes that start fail as a refused std::thread does (a
+// std::system_error), so tests can exercise the fallback where the process
+// limit cannot be lowered (as root). Not for production use.
+inline bool (*refuse_worker_for_testing)(std::size_t worker) = nullptr;
+}  // namespace parallel_detail
+
 class ChunkPool {
  public:
-  explicit ChunkPool(int threads) {
-    const std::size_t worker_count = threads > 1 ? static_cast<std::size_t>(threads - 1) : 0;
+  // Up to threads - 1 workers, fewer when the pool will never have that
+  // many tasks at once (`tasks`: the largest `chunks` of any run) or when
+  // that exceeds kMaxWorkers; fewer still if the system refuses to start
+  // them (then threads() says how many there are).
+  explicit ChunkPool(int threads, std::size_t tasks = std::numeric_limits<std::size_t>::max()) {
+    const std::size_t requested = threads > 1 ? static_cast<std::size_t>(threads - 1) : 0;
+    const std::size_t useful = tasks > 0 ? tasks - 1 : 0;  // the caller takes one task
+    const std::size_t worker_count = std::min({requested, useful, kMaxWorkers});
     workers_.reserve(worker_count);
-    for (std::size_t k = 0; k < worker_count; ++k)
-      workers_.emplace_back([this] { serve(); });
+    for (std::size_t k = 0; k < worker_count; ++k) {
+      try {
+        if (parallel_detail::refuse_worker_for_testing &&
+            parallel_detail::refuse_worker_for_testing(k)) {
+          throw std::system_error(std::make_error_code(std::errc::resource_unavailable_try_again));
+        }
+        workers_.emplace_back([this] { serve(); });
+      } catch (const std::system_error&) {
+        break;  // the workers started so far serve; the caller does the rest
+      } catch (const std::bad_alloc&) {
+        break;
+      }
+    }
   }
   ChunkPool(const ChunkPool&) = delete;
   ChunkPool& operator=(const ChunkPool&) = delete;

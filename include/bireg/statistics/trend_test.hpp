@@ -343,7 +343,7 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
   std::vector<Verdict> verdicts(count);
   const std::size_t blocks =
       (count + trend_detail::kPermutationBlock - 1) / trend_detail::kPermutationBlock;
-  ChunkPool(options.threads).run(blocks, [&](std::size_t block) {
+  ChunkPool(options.threads, blocks).run(blocks, [&](std::size_t block) {
     trend_detail::FitBuffers<G> buffers;
     const std::size_t end = std::min(count, (block + 1) * trend_detail::kPermutationBlock);
     for (std::size_t b = block * trend_detail::kPermutationBlock; b < end; ++b)
