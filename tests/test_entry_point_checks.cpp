@@ -185,3 +185,40 @@ TEST_CASE("workers are capped and a refused worker leaves fewer (issue 37 item 3
   std::vector<double> u(t.begin(), t.begin() + 8200);
   REQUIRE(identical(fit_with_threads(1, g, u), fit_with_threads(10000, g, u)));
 }
+
+TEST_CASE(
+    "quantiles at huge degrees of freedom are the chi-square limit "
+    "(issue 37 item 14)",
+    "[hostile][distributions]") {
+  const double level = 0.95;
+  const double chi6 = *bireg::chi_square_quantile(level, 6);
+  const double chi12 = *bireg::chi_square_quantile(level, 12);
+  const auto relative = [](double value, double reference) {
+    return std::abs(value - reference) / reference;
+  };
+  // F(d1, d2) = (chi2_{d1} / d1) / (chi2_{d2} / d2), chi2_{d2} / d2 -> 1
+  // with standard deviation sqrt(2 / d2): at d2 >= 1e16 the limit holds to
+  // ~1e-15, so 1e-12 relative leaves the bisection's rounding room.
+  for (const double nu : {1e16, 1e100, 1e300}) {
+    CAPTURE(nu);
+    REQUIRE(relative(*bireg::f_quantile(level, 6, nu), chi6 / 6) < 1e-12);
+    REQUIRE(relative(*bireg::hotelling_quantile(level, 6, nu), chi6) < 1e-12);
+    REQUIRE(relative(*bireg::ellipsoid_quantile(level, 6, 1, nu), chi6) < 1e-12);
+    REQUIRE(relative(*bireg::ellipsoid_quantile(level, 6, 2, nu), chi12) < 1e-12);
+  }
+  // Large but not huge d2: F_{0.95}(6, d2) computed independently of
+  // bireg (mpmath, 40 digits: findroot of betainc(3, d2/2, 0, 6f/(6f + d2),
+  // regularized) - 0.95). The first correction of the chi-square limit
+  // leaves O(x^3 / d2^2) ~ 1e-13 relative at d2 = 1e7, so 1e-12 is rounding
+  // room; the incomplete beta's continued fraction was off by 1e-10 at 1e8
+  // and 2e-6 at 1e12 (too few terms for b = d2/2).
+  struct Reference {
+    double d2, quantile;
+  };
+  for (const Reference r :
+       {Reference{1e7, 2.098598775471848116482114}, Reference{1e8, 2.09859796410876535233364},
+        Reference{1e10, 2.098597874858844250292262}, Reference{1e12, 2.098597873966345057290078}}) {
+    CAPTURE(r.d2);
+    REQUIRE(relative(*bireg::f_quantile(level, 6, r.d2), r.quantile) < 1e-12);
+  }
+}

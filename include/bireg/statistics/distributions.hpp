@@ -12,8 +12,22 @@
 // distribution function by bisection: monotone, bracketed, and 200 halvings
 // reach the resolution of double on any bracket, so no convergence
 // question arises.
+//
+// Huge degrees of freedom. log B(a, b) is formed without the cancellation
+// of lgamma(a + b) - lgamma(b) (both ~ b log b, their difference ~ a log b)
+// when b is large. An F quantile whose denominator degrees of freedom d2
+// reach kChiSquareLimit is the chi-square limit with its first correction,
+//   d1 F_q = x (1 + (x - d1 + 2) / (2 d2)) + O(x^3 / d2^2),  x = chi2_{d1} quantile
+// (F = (chi2_{d1} / d1) / Y, Y = chi2_{d2} / d2 of mean 1 and variance
+// 2 / d2: P(chi2_{d1} <= x Y) moves by x^2 g'(x) / d2 for the chi2_{d1}
+// density g, and x^2 g'/g = x (d1/2 - 1) - x^2/2). There the remainder is
+// below 1e-12 relative, whereas the incomplete beta's continued fraction
+// needs ~sqrt(d2) terms near the quantile (more than kMaxTerms: errors of
+// 1e-10 at d2 = 1e8, 2e-6 at 1e12) and the bisection on u = d1 x / (d1 x +
+// d2) in [0, 1] cannot resolve u ~ d1 / d2 below 2^-200 (d2 ~ 1e61 on).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -25,6 +39,26 @@ namespace distribution_detail {
 inline constexpr int kMaxTerms = 1000;
 inline constexpr double kRelative = 1e-16;
 inline constexpr double kTiny = 1e-300;
+// From this argument on, lgamma differences use Stirling's series.
+inline constexpr double kStirlingFrom = 1e6;
+
+// log(Gamma(a + b) / (Gamma(a) Gamma(b))) = -log B(a, b), a, b > 0. With
+// s = min(a, b), l = max(a, b) >= kStirlingFrom, Stirling's series
+// lgamma(z) = (z - 1/2) log z - z + log(2 pi)/2 + 1/(12 z) - 1/(360 z^3)
+// + O(z^-5) (the next term, 1/(1260 z^5), is below 1e-33 here) gives
+//   lgamma(s + l) - lgamma(l) = (l - 1/2) log1p(s/l) + s log(s + l) - s
+//                               + 1/(12 (s + l)) - 1/(12 l)
+//                               - 1/(360 (s + l)^3) + 1/(360 l^3),
+// whose terms are each of the size of the result (log1p keeps s/l).
+inline double log_inverse_beta(double a, double b) {
+  const double small = std::min(a, b), large = std::max(a, b);
+  if (large < kStirlingFrom) return std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b);
+  const double sum = small + large;
+  const double leading = (large - 0.5) * std::log1p(small / large) + small * std::log(sum) - small;
+  const double first_correction = 1 / (12 * sum) - 1 / (12 * large);
+  const double second_correction = 1 / (360 * sum * sum * sum) - 1 / (360 * large * large * large);
+  return leading + first_correction - second_correction - std::lgamma(small);
+}
 
 // P(a, x) by the series x^a e^{-x} / Gamma(a + 1) sum_n x^n / ((a+1)...(a+n)).
 inline double gamma_series(double a, double x) {
@@ -109,7 +143,7 @@ inline double regularized_beta(double a, double b, double x) {
   if (!(x > 0)) return 0;
   if (!(x < 1)) return 1;
   const double log_prefactor =
-      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
+      distribution_detail::log_inverse_beta(a, b) + a * std::log(x) + b * std::log1p(-x);
   const double prefactor = std::exp(log_prefactor);
   if (x < (a + 1) / (a + b + 2)) {
     return prefactor * distribution_detail::beta_continued_fraction(a, b, x) / a;
@@ -139,10 +173,23 @@ inline std::optional<double> chi_square_quantile(double level, double k) {
                                      high);
 }
 
-// Bisection on u = d1 x / (d1 x + d2) in [0, 1], where I_u is bracketed.
+// Denominator degrees of freedom from which f_quantile is the chi-square
+// limit with its first correction (see the top of this file).
+inline constexpr double kChiSquareLimit = 1e7;
+
+// Bisection on u = d1 x / (d1 x + d2) in [0, 1], where I_u is bracketed;
+// for d2 >= kChiSquareLimit the chi-square limit with its first correction.
 inline std::optional<double> f_quantile(double level, double d1, double d2) {
-  if (!(level > 0 && level < 1) || !(d1 > 0) || !(d2 > 0) || !std::isfinite(d1 + d2)) {
+  if (!(level > 0 && level < 1) || !(d1 > 0) || !(d2 > 0) || !std::isfinite(d1) ||
+      !std::isfinite(d2)) {
     return std::nullopt;
+  }
+  if (d2 >= kChiSquareLimit) {
+    const std::optional<double> chi_square = chi_square_quantile(level, d1);
+    if (!chi_square) return std::nullopt;
+    const double x = *chi_square;
+    const double correction = (x - d1 + 2) / (2 * d2);
+    return x / d1 * (1 + correction);
   }
   const double u = distribution_detail::bisect(
       [d1, d2](double v) { return regularized_beta(d1 / 2, d2 / 2, v); }, level, 0, 1);
@@ -156,16 +203,22 @@ inline std::optional<double> f_quantile(double level, double d1, double d2) {
 // nu - p + 1). Exact on R^n for a single vector (the velocity, the pose at
 // one covariate, a prediction). Needs nu > p - 1.
 inline std::optional<double> hotelling_quantile(double level, double p, double nu) {
-  if (!(nu - p + 1 > 0)) return std::nullopt;
-  const std::optional<double> f = f_quantile(level, p, nu - p + 1);
+  const double denominator = nu - p + 1;
+  if (!(denominator > 0)) return std::nullopt;
+  const std::optional<double> f = f_quantile(level, p, denominator);
   if (!f) return std::nullopt;
-  return nu * p / (nu - p + 1) * *f;
+  // nu / (nu - p + 1) first: nu p alone overflows for nu near the largest double.
+  return nu / denominator * p * *f;
 }
 
 // The Lawley-Hotelling trace U = nu tr(B E^{-1}), B ~ Wishart_p(q), E ~
 // Wishart_p(nu), by McKeon's (1974) approximation U / nu ~ g F(a, b):
 //   a = p q,  B = (nu + q - p - 1)(nu - 1) / ((nu - p - 3)(nu - p)),
 //   b = 4 + (a + 2)/(B - 1),  g = a (b - 2) / (b (nu - p - 1)).
+// B - 1 ~ (p + q + 1)/nu vanishes as nu grows; it is formed without that
+// cancellation (expanding the products of B's numerator and denominator),
+//   B - 1 = ((p + q + 1) nu + 1 - q - p^2 - 2p) / ((nu - p - 3)(nu - p)),
+// and no product of two nu's is formed (nu up to the largest double).
 // It is exact for q = 1 (where it reduces to Hotelling's T^2). This is the
 // Mahalanobis distance of the two endpoints together (q = 2: a line's two
 // values share one estimated d x d covariance). Needs nu > p + 3.
@@ -174,12 +227,15 @@ inline std::optional<double> lawley_hotelling_quantile(double level, double p, d
   if (q == 1) return hotelling_quantile(level, p, nu);
   if (!(nu - p - 3 > 0)) return std::nullopt;
   const double a = p * q;
-  const double big_b = (nu + q - p - 1) * (nu - 1) / ((nu - p - 3) * (nu - p));
-  const double b = 4 + (a + 2) / (big_b - 1);
-  const double g = a * (b - 2) / (b * (nu - p - 1));
+  const double slope = p + q + 1, offset = 1 - q - p * p - 2 * p;
+  const double big_b_minus_one =
+      (slope + offset / nu) / (nu - p - 3) * (nu / (nu - p));  // B - 1, nu divided out
+  const double b = 4 + (a + 2) / big_b_minus_one;
+  // nu g = a ((b - 2)/b) (nu / (nu - p - 1)).
+  const double nu_g = a * ((b - 2) / b) * (nu / (nu - p - 1));
   const std::optional<double> f = f_quantile(level, a, b);
   if (!f) return std::nullopt;
-  return nu * g * *f;
+  return nu_g * *f;
 }
 
 }  // namespace bireg
