@@ -222,3 +222,50 @@ TEST_CASE(
     REQUIRE(relative(*bireg::f_quantile(level, 6, r.d2), r.quantile) < 1e-12);
   }
 }
+
+namespace {
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("enumerations out of range are refused with a message (issue 37 item 2)",
+          "[hostile][enumerations]") {
+  std::mt19937 rng(2);
+  std::normal_distribution<double> normal(0.0, 0.05);
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<double> times;
+  for (int i = 0; i < 30; ++i) {
+    const double t = i / 29.0;
+    rotations.push_back(
+        SO3d::exp(Eigen::Vector3d(0.5 * t + normal(rng), normal(rng), -0.3 * t + normal(rng))));
+    times.push_back(t);
+  }
+
+  SECTION("Loss") {
+    bireg::RobustOptions<double> options;
+    options.loss = static_cast<bireg::Loss>(7);
+    const auto robust = bireg::RobustGeodesicRegression<SO3d>(options).fit(rotations, times);
+    CAPTURE(robust.message);
+    REQUIRE(robust.status == bireg::RobustStatus::invalid_input);
+    REQUIRE(contains(robust.message, "loss"));
+    options.loss = bireg::Loss::tukey;
+    REQUIRE(bireg::RobustGeodesicRegression<SO3d>(options).fit(rotations, times).status ==
+            bireg::RobustStatus::converged);
+  }
+  SECTION("CovarianceFlavour") {
+    const auto fit = bireg::GeodesicRegression<SO3d>().fit(rotations, times);
+    REQUIRE(fit.ok());
+    for (const int flavour : {2, 7, -1}) {
+      CAPTURE(flavour);
+      const auto c =
+          bireg::covariance(fit, times, {}, static_cast<bireg::CovarianceFlavour>(flavour));
+      CAPTURE(c.message);
+      REQUIRE(c.status == bireg::CovarianceStatus::invalid_input);
+      REQUIRE(contains(c.message, "flavour"));
+    }
+    REQUIRE(bireg::covariance(fit, times, {}, bireg::CovarianceFlavour::robust).defined());
+  }
+}

@@ -113,9 +113,15 @@ inline const char* to_string(CovarianceFlavour flavour) {
   return flavour == CovarianceFlavour::robust ? "robust" : "homoscedastic";
 }
 
+// Whether `flavour` is one of the enumerators (an integer cast to it may not be).
+constexpr bool is_valid(CovarianceFlavour flavour) {
+  return flavour == CovarianceFlavour::homoscedastic || flavour == CovarianceFlavour::robust;
+}
+
 enum class CovarianceStatus {
   defined,
-  invalid_input,  // the fit failed or the covariates/weights do not match it
+  invalid_input,  // the fit failed, the covariates/weights do not match it, or the flavour is
+                  // unknown
   // no degrees of freedom, zero residuals, leverage 1, or (robust) a quantity
   // with zero covariance: the message says which
   undefined,
@@ -407,6 +413,11 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   using covariance_detail::refused;
   using std::sqrt;
   const std::size_t n = problem.size();
+  if (!is_valid(flavour)) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      "flavour must be homoscedastic or robust (got " +
+                          std::to_string(static_cast<int>(flavour)) + ")");
+  }
   if (residuals.size() != n) {
     return refused<G>(CovarianceStatus::invalid_input,
                       "the residuals are not the problem's (" + std::to_string(residuals.size()) +
@@ -561,6 +572,11 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
                             CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
   using Scalar = typename G::Scalar;
   using covariance_detail::refused;
+  if (!is_valid(flavour)) {
+    return refused<G>(CovarianceStatus::invalid_input,
+                      "flavour must be homoscedastic or robust (got " +
+                          std::to_string(static_cast<int>(flavour)) + ")");
+  }
   if (!fit.ok() || !fit.geodesic) {
     return refused<G>(CovarianceStatus::invalid_input,
                       std::string("the fit did not succeed (status ") + to_string(fit.status) +

@@ -175,6 +175,11 @@ class RobustGeodesicRegression {
     using std::isfinite;
     Result result;
     result.loss = options_.loss;
+    if (!is_valid(options_.loss)) {  // it indexes the tables of constants below
+      result.message = "loss must be huber, cauchy or tukey (got " +
+                       std::to_string(static_cast<int>(options_.loss)) + ")";
+      return result;
+    }
     if (!(options_.loss_scale >= 0) || !isfinite(options_.loss_scale)) {
       result.message = "loss_scale must be a finite non-negative number (0 = 95% efficiency)";
       return result;

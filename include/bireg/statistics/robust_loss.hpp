@@ -56,6 +56,11 @@ inline const char* to_string(Loss loss) {
   return "unknown";
 }
 
+// Whether `loss` is one of the enumerators (an integer cast to Loss may not be).
+constexpr bool is_valid(Loss loss) {
+  return loss == Loss::huber || loss == Loss::cauchy || loss == Loss::tukey;
+}
+
 // Whether the loss's weight goes to zero far out (it then needs a robust start).
 constexpr bool redescends(Loss loss) {
   return loss != Loss::huber;
