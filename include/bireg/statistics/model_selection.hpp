@@ -86,6 +86,18 @@
 // `ambiguous` is set and the table says so; the recommended one is then the
 // one of smaller C.
 //
+// Refusals and statuses. Before any work the input is checked: equal,
+// non-empty lengths; every covariate finite and within half the largest
+// double (so that any difference of two covariates is finite); every pose
+// finite and an element of its group (SE(3): a rotation block and the last
+// row (0, 0, 0, 1); Sim(3): a similarity block); the enumerations known.
+// A refusal has status invalid_input, a message and bad_index naming the
+// observation (or covariate) at fault. A candidate whose criterion or
+// RMS is not finite (residuals whose squares overflow: translations near
+// 1e154 or beyond) is excluded with a note, like one whose fit failed; if
+// no candidate is left the status is no_candidate and nothing is
+// recommended. Nothing in a result is NaN.
+//
 // Second opinion: K-fold cross-validated prediction error, folds assigned by
 // the rank of the covariate (rank mod K; ties broken by the pose's input
 // index, so shuffling the input keeps the folds whenever covariates are
@@ -102,6 +114,7 @@
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -129,6 +142,29 @@ enum class MotionModel {
 
 // The group the poses are elements of, and the residuals' space.
 enum class PoseGroup { se3, sim3 };
+
+constexpr bool is_valid(PoseGroup group) {
+  return group == PoseGroup::se3 || group == PoseGroup::sim3;
+}
+
+// How a selection ended.
+enum class SelectionStatus {
+  selected,       // a model is recommended
+  invalid_input,  // refused before any work: message and bad_index say why
+  no_candidate,   // no candidate could be fitted and scored: message says why
+};
+
+inline const char* to_string(SelectionStatus status) {
+  switch (status) {
+    case SelectionStatus::selected:
+      return "selected";
+    case SelectionStatus::invalid_input:
+      return "invalid_input";
+    case SelectionStatus::no_candidate:
+      return "no_candidate";
+  }
+  return "unknown";
+}
 
 inline const char* to_string(MotionModel model) {
   switch (model) {
@@ -234,11 +270,15 @@ struct MotionPrediction {
 };
 
 struct ModelSelection {
+  SelectionStatus status = SelectionStatus::invalid_input;
+  std::ptrdiff_t bad_index = -1;               // invalid_input: the observation at fault, or -1
   std::vector<CandidateReport> candidates;     // in the order of kMotionModels (or kSimilarity...)
-  std::optional<MotionModel> recommended;      // empty if no candidate could be fitted
+  std::optional<MotionModel> recommended;      // empty unless status is selected
   std::optional<MotionPrediction> prediction;  // the recommended model's fit
   bool ambiguous = false;  // another model of equal complexity is within the margin
   std::string message;
+
+  bool ok() const { return status == SelectionStatus::selected; }
 };
 
 namespace model_selection_detail {
@@ -251,6 +291,49 @@ using Matrix3 = Eigen::Matrix3d;
 template <PoseGroup group>
 using Ambient = std::conditional_t<group == PoseGroup::sim3, Sim3d, SE3d>;
 
+constexpr bool is_valid(MotionModel model) {
+  return model == MotionModel::static_pose || model == MotionModel::rotation_only ||
+         model == MotionModel::translation_only || model == MotionModel::rotation_and_line ||
+         model == MotionModel::screw || model == MotionModel::similarity;
+}
+
+// Lengths and covariates: equal, non-empty lengths, and every covariate
+// finite with |t| <= max/2, so that t_i - t_j never overflows (the range,
+// the centring below, the fits' map onto [0, 1]). The first covariate at
+// fault is named.
+template <class Times>
+std::optional<Rejection> check_covariates(std::size_t observations, const Times& times) {
+  if (observations != times.size() || observations == 0) {
+    return Rejection{"observations and covariates must be non-empty and of equal length (" +
+                     std::to_string(observations) + " vs " + std::to_string(times.size()) + ")"};
+  }
+  const double half_range = std::numeric_limits<double>::max() / 2;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    const double t = times[i];
+    const auto index = static_cast<std::ptrdiff_t>(i);
+    if (!std::isfinite(t)) {
+      return Rejection{"covariate " + std::to_string(i) + " is not finite", index};
+    }
+    if (std::abs(t) > half_range) {
+      return Rejection{"covariate " + std::to_string(i) +
+                           " exceeds half the largest double in magnitude: differences of "
+                           "covariates would overflow",
+                       index};
+    }
+  }
+  return std::nullopt;
+}
+
+// Lengths, covariates, then every observation finite and an element of G
+// (to the default element tolerance); the first at fault is named.
+template <class G, class Observations>
+std::optional<Rejection> check_input(const Observations& observations,
+                                     const std::vector<double>& times, int threads) {
+  if (auto rejection = check_covariates(observations.size(), times)) return rejection;
+  if (threads < 1) return Rejection{"threads must be at least 1, got " + std::to_string(threads)};
+  return check_observations<G>(observations, default_element_tolerance<typename G::Scalar>());
+}
+
 template <PoseGroup group, class Poses>
 std::optional<MotionPrediction> fit_model(MotionModel model, const Poses& poses,
                                           const std::vector<double>& times) {
@@ -258,6 +341,7 @@ std::optional<MotionPrediction> fit_model(MotionModel model, const Poses& poses,
   MotionPrediction predictor;
   predictor.model = model;
   const std::size_t n = poses.size();
+  if (!is_valid(model)) return std::nullopt;
   if (model == MotionModel::static_pose) {
     const auto m = mean<G>(poses);
     if (!m.ok()) return std::nullopt;
@@ -386,7 +470,8 @@ std::vector<std::optional<double>> cv_errors(const Observations& observations,
       complete = fold_sums[c * fold_count + k].has_value();
       if (complete) squared_sum += *fold_sums[c * fold_count + k];
     }
-    if (complete) errors[c] = squared_sum / static_cast<double>(observations.size());
+    const double error = squared_sum / static_cast<double>(observations.size());
+    if (complete && std::isfinite(error)) errors[c] = error;
   }
   return errors;
 }
@@ -437,12 +522,9 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
   using Tangent = typename G::Tangent;
   ModelSelection selection;
   const std::size_t n = poses.size();
-  if (n != times.size() || n == 0) {
-    selection.message = "poses and times must be non-empty and of equal length";
-    return selection;
-  }
-  if (options.threads < 1) {
-    selection.message = "threads must be at least 1, got " + std::to_string(options.threads);
+  if (auto rejection = check_input<G>(poses, times, options.threads)) {
+    selection.message = rejection->message;
+    selection.bad_index = rejection->index;
     return selection;
   }
   const double n_real = static_cast<double>(n);
@@ -453,7 +535,10 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
   std::vector<std::optional<MotionPrediction>> predictors(models.size());
   std::vector<std::vector<Tangent>> residuals(models.size());
   selection.candidates.resize(models.size());
-  ChunkPool pool(options.threads);  // the candidates' fits, then the folds'
+  // The candidates' fits, then the folds': at most that many tasks at once.
+  const std::size_t fold_tasks =
+      models.size() * static_cast<std::size_t>(std::max(options.folds, 1));
+  ChunkPool pool(options.threads, std::max(models.size(), fold_tasks));
   pool.run(models.size(), [&](std::size_t c) {
     CandidateReport& report = selection.candidates[c];
     report.model = models[c];
@@ -486,11 +571,27 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
       rotation_squares += ri.template segment<3>(3).squaredNorm();
       if constexpr (group == PoseGroup::sim3) scale_squares += ri[6] * ri[6];
     }
-    report.rotation_rms_degrees = std::sqrt(rotation_squares / n_real) * rad_to_deg;
-    report.translation_rms = std::sqrt(translation_squares / n_real);
-    report.log_scale_rms = std::sqrt(scale_squares / n_real);
-    report.log_det = floored_log_det(residual_covariance(residuals[c]), floor);
-    report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
+    const double rotation_rms_degrees = std::sqrt(rotation_squares / n_real) * rad_to_deg;
+    const double translation_rms = std::sqrt(translation_squares / n_real);
+    const double log_scale_rms = std::sqrt(scale_squares / n_real);
+    const double log_det = floored_log_det(residual_covariance(residuals[c]), floor);
+    const double criterion = n_real / 2 * log_det + report.parameters / 2.0 * std::log(n_real);
+    // Squares of residuals beyond ~1e154 overflow: such a candidate cannot
+    // be scored (a NaN or infinite criterion would compare with nothing).
+    const bool finite = std::isfinite(floor) && std::isfinite(rotation_squares) &&
+                        std::isfinite(translation_squares) && std::isfinite(scale_squares) &&
+                        std::isfinite(criterion);
+    if (!finite) {
+      report.fitted = false;
+      report.note = "excluded: its residuals' squares overflow (criterion not finite)";
+      predictors[c].reset();
+      continue;
+    }
+    report.rotation_rms_degrees = rotation_rms_degrees;
+    report.translation_rms = translation_rms;
+    report.log_scale_rms = log_scale_rms;
+    report.log_det = log_det;
+    report.criterion = criterion;
     if (!best || report.criterion < *best) best = report.criterion;
   }
   if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
@@ -505,7 +606,8 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
       selection.candidates[c].cv_error = errors[c];
   }
   if (!best) {
-    selection.message = "no candidate could be fitted";
+    selection.status = SelectionStatus::no_candidate;
+    selection.message = "no candidate could be fitted and scored (see each candidate's note)";
     return selection;
   }
 
@@ -521,6 +623,12 @@ ModelSelection select(const Poses& poses, const std::vector<double>& times,
                                   report.criterion < selection.candidates[*chosen].criterion;
     if (simpler || equal_but_better) chosen = c;
   }
+  if (!chosen) {  // unreachable: the best finite criterion is within the margin of itself
+    selection.status = SelectionStatus::no_candidate;
+    selection.message = "no candidate's criterion is within the margin of the best";
+    return selection;
+  }
+  selection.status = SelectionStatus::selected;
   CandidateReport& winner = selection.candidates[*chosen];
   winner.recommended = true;
   selection.recommended = winner.model;
@@ -559,23 +667,36 @@ struct TrendCandidate {
 
 template <class G>
 struct TrendSelection {
+  SelectionStatus status = SelectionStatus::invalid_input;
+  std::ptrdiff_t bad_index = -1;  // invalid_input: the observation or covariate at fault, or -1
   std::vector<TrendCandidate> candidates;             // static, then geodesic
-  std::optional<TrendModel> recommended;              // empty if neither could be fitted
+  std::optional<TrendModel> recommended;              // empty unless status is selected
   std::optional<typename G::Element> static_element;  // the mean, if fitted
-  std::optional<Geodesic<G>> geodesic;                // the geodesic fit, if fitted
+  std::optional<Geodesic<G>> geodesic;  // the geodesic fit in the user's covariates, if fitted
   std::string message;
+
+  bool ok() const { return status == SelectionStatus::selected; }
 };
 
 namespace model_selection_detail {
 
-// The prediction of a static or geodesic candidate fitted to `observations`.
+// The prediction of a static or geodesic candidate fitted to `observations`
+// at centred covariates `times`. The static one is the constant geodesic
+// (m, m) parametrised on `span` (the centred covariates' range, first <
+// second): evaluated at any covariate of the data it computes
+// m exp(s log(m^{-1} m)) with s in [0, 1], so the rounding-level
+// log(m^{-1} m) (a few epsilon) stays at that level; on (0, 1) it would be
+// multiplied by the covariate itself (1.4e18 for nanosecond timestamps).
 template <class G, class Observations>
 std::optional<Geodesic<G>> fit_trend_model(TrendModel model, const Observations& observations,
-                                           const std::vector<double>& times) {
+                                           const std::vector<double>& times,
+                                           std::pair<double, double> span) {
+  using Scalar = typename G::Scalar;
   if (model == TrendModel::static_element) {
     const auto m = mean<G>(observations);
     if (!m.ok()) return std::nullopt;
-    return Geodesic<G>(*m.mean, *m.mean, 0.0, 1.0);
+    return Geodesic<G>(*m.mean, *m.mean, static_cast<Scalar>(span.first),
+                       static_cast<Scalar>(span.second));
   }
   const auto fit = GeodesicRegression<G>().fit(observations, times);
   if (!fit.ok()) return std::nullopt;
@@ -593,25 +714,45 @@ typename G::Tangent trend_residual(const Geodesic<G>& prediction,
 // Static against geodesic for `observations` of any group G (indexable,
 // with size()) at covariates `times`: the recommendation is the static
 // model unless the geodesic's criterion is lower by more than
-// kSelectionMargin. Never throws for bad data, never returns NaN: a model
-// that cannot be fitted (N below its parameter count, a failed fit) is
-// excluded with a note.
+// kSelectionMargin. Never throws for bad data, never returns NaN: input
+// refused as select_motion_model refuses it (a covariate not finite or
+// beyond half the largest double, an observation not finite or not in G)
+// has status invalid_input, naming the index; a model that cannot be
+// fitted or scored (N below its parameter count, a failed fit, an
+// overflowing criterion) is excluded with a note; with neither left the
+// status is no_candidate.
+//
+// Covariates are centred before any arithmetic: c_i = t_i - t_ref with
+// t_ref the midpoint of their range, so that covariates far from zero
+// (EuRoC nanoseconds as doubles, 1.4e18 + 5e6 i) are worked on as their
+// differences, which double holds exactly enough; the geodesic returned is
+// parametrised in the user's covariates again.
 template <class G, class Observations>
 TrendSelection<G> select_static_or_geodesic(const Observations& observations,
                                             const std::vector<double>& times,
                                             const ModelSelectionOptions& options = {}) {
   namespace detail = model_selection_detail;
   using Tangent = typename G::Tangent;
+  using Scalar = typename G::Scalar;
   TrendSelection<G> selection;
   const std::size_t n = observations.size();
-  if (n != times.size() || n == 0) {
-    selection.message = "observations and times must be non-empty and of equal length";
+  if (auto rejection = detail::check_input<G>(observations, times, options.threads)) {
+    selection.message = rejection->message;
+    selection.bad_index = rejection->index;
     return selection;
   }
-  if (options.threads < 1) {
-    selection.message = "threads must be at least 1, got " + std::to_string(options.threads);
-    return selection;
-  }
+  // Centring: |t_i| <= max/2 (checked), so every c_i is finite; the
+  // midpoint min/2 + max/2 cannot overflow.
+  const auto [smallest, largest] = std::minmax_element(times.begin(), times.end());
+  const double reference = *smallest / 2 + *largest / 2;
+  std::vector<double> centred(n);
+  for (std::size_t i = 0; i < n; ++i)
+    centred[i] = times[i] - reference;
+  const double low = *smallest - reference, high = *largest - reference;
+  // The static candidate's parametrisation (any interval will do if all
+  // covariates are equal).
+  const std::pair<double, double> span =
+      high > low ? std::pair(low, high) : std::pair(low, low + 1);
   const double n_real = static_cast<double>(n);
   std::vector<std::vector<Tangent>> residuals;
   for (TrendModel model : {TrendModel::static_element, TrendModel::geodesic}) {
@@ -623,18 +764,22 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
       report.note = "excluded: " + std::to_string(n) + " observations, fewer than its " +
                     std::to_string(report.parameters) + " parameters";
     } else {
-      prediction = detail::fit_trend_model<G>(model, observations, times);
+      prediction = detail::fit_trend_model<G>(model, observations, centred, span);
       if (!prediction) report.note = "excluded: its fit failed";
     }
     std::vector<Tangent> r;
     if (prediction) {
       report.fitted = true;
       for (std::size_t i = 0; i < n; ++i)
-        r.push_back(detail::trend_residual<G>(*prediction, observations[i], times[i]));
+        r.push_back(detail::trend_residual<G>(*prediction, observations[i], centred[i]));
       if (model == TrendModel::static_element) {
-        selection.static_element = (*prediction)(0.0);
+        selection.static_element = prediction->start();
       } else {
-        selection.geodesic = prediction;
+        // Back to the user's covariates: gamma(t) = fit(t - t_ref).
+        selection.geodesic =
+            Geodesic<G>(prediction->start(), prediction->end(),
+                        static_cast<Scalar>(static_cast<double>(prediction->t_min()) + reference),
+                        static_cast<Scalar>(static_cast<double>(prediction->t_max()) + reference));
       }
     }
     residuals.push_back(r);
@@ -648,32 +793,50 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
     double squares = 0;
     for (const auto& ri : residuals[c])
       squares += ri.squaredNorm();
+    const double log_det =
+        detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
+    const double criterion = n_real / 2 * log_det + report.parameters / 2.0 * std::log(n_real);
+    if (!std::isfinite(floor) || !std::isfinite(squares) || !std::isfinite(criterion)) {
+      report.fitted = false;
+      report.note = "excluded: its residuals' squares overflow (criterion not finite)";
+      if (report.model == TrendModel::static_element) {
+        selection.static_element.reset();
+      } else {
+        selection.geodesic.reset();
+      }
+      continue;
+    }
     report.residual_rms = std::sqrt(squares / n_real);
-    report.log_det = detail::floored_log_det(detail::residual_covariance(residuals[c]), floor);
-    report.criterion = n_real / 2 * report.log_det + report.parameters / 2.0 * std::log(n_real);
+    report.log_det = log_det;
+    report.criterion = criterion;
     if (!best || report.criterion < *best) best = report.criterion;
   }
   if (options.folds >= 2 && n >= static_cast<std::size_t>(options.folds)) {
     using Element = typename G::Element;
-    ChunkPool pool(options.threads);
+    const std::size_t tasks = selection.candidates.size() * static_cast<std::size_t>(options.folds);
+    ChunkPool pool(options.threads, tasks);
     const std::vector<std::optional<double>> errors = detail::cv_errors<Element>(
-        observations, times, options.folds, selection.candidates.size(),
+        observations, centred, options.folds, selection.candidates.size(),
         [&](std::size_t c) { return selection.candidates[c].fitted; },
         [&](std::size_t c, const std::vector<Element>& train,
             const std::vector<double>& train_times) {
-          return detail::fit_trend_model<G>(selection.candidates[c].model, train, train_times);
+          return detail::fit_trend_model<G>(selection.candidates[c].model, train, train_times,
+                                            span);
         },
         detail::trend_residual<G>, pool);
     for (std::size_t c = 0; c < selection.candidates.size(); ++c)
       selection.candidates[c].cv_error = errors[c];
   }
   if (!best) {
-    selection.message = "neither model could be fitted";
+    selection.status = SelectionStatus::no_candidate;
+    selection.message = "neither model could be fitted and scored (see each candidate's note)";
     return selection;
   }
-  // The static model has fewer parameters: it wins within the margin.
+  // The static model has fewer parameters: it wins within the margin. The
+  // best finite criterion is within the margin of itself, so one does.
   for (TrendCandidate& report : selection.candidates)
     report.within_margin = report.fitted && report.criterion <= *best + kSelectionMargin;
+  selection.status = SelectionStatus::selected;
   TrendCandidate& winner = selection.candidates[selection.candidates[0].within_margin ? 0 : 1];
   winner.recommended = true;
   selection.recommended = winner.model;
@@ -681,28 +844,44 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
 }
 
 // One candidate fitted alone: its prediction P(t) at any covariate, or
-// nothing if its fit failed (or `model` is `similarity` and the poses are
-// SE(3)).
+// nothing if its fit failed, the input is refused (as select_motion_model
+// refuses it: a pose that is not an element of `group`, a covariate that
+// is not finite, ...; an unknown model or group) or `model` is
+// `similarity` and the poses are SE(3).
 template <class Poses>
 std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses& poses,
                                                  const std::vector<double>& times,
                                                  PoseGroup group = PoseGroup::se3) {
   namespace detail = model_selection_detail;
-  if (group == PoseGroup::sim3) return detail::fit_model<PoseGroup::sim3>(model, poses, times);
+  if (!is_valid(group) || !detail::is_valid(model)) return std::nullopt;
+  if (group == PoseGroup::sim3) {
+    if (detail::check_input<Sim3d>(poses, times, 1)) return std::nullopt;
+    return detail::fit_model<PoseGroup::sim3>(model, poses, times);
+  }
+  if (detail::check_input<SE3d>(poses, times, 1)) return std::nullopt;
   return detail::fit_model<PoseGroup::se3>(model, poses, times);
 }
 
 // Compare the pose-motion models on `poses` (indexable 4x4 matrices with
 // size(): SE(3) elements, or Sim(3) ones with options.group = sim3) at
 // covariates `times`: the five rigid candidates, and for similarities the
-// sixth, `similarity`. Never throws for bad data, never returns NaN: a model
-// that cannot be fitted (N below its parameter count, a failed fit) is
-// excluded with a note. The recommended model's fit is returned with the
-// table (`prediction`), so the caller need not refit it.
+// sixth, `similarity`. Never throws for bad data, never returns NaN:
+// refused input (see "Refusals and statuses" above) has status
+// invalid_input, naming the observation; a model that cannot be fitted or
+// scored (N below its parameter count, a failed fit, an overflowing
+// criterion) is excluded with a note; with none left the status is
+// no_candidate. The recommended model's fit is returned with the table
+// (`prediction`), so the caller need not refit it.
 template <class Poses>
 ModelSelection select_motion_model(const Poses& poses, const std::vector<double>& times,
                                    const ModelSelectionOptions& options = {}) {
   namespace detail = model_selection_detail;
+  if (!is_valid(options.group)) {
+    ModelSelection refused;
+    refused.message = "options.group must be se3 or sim3 (got " +
+                      std::to_string(static_cast<int>(options.group)) + ")";
+    return refused;
+  }
   if (options.group == PoseGroup::sim3)
     return detail::select<PoseGroup::sim3>(poses, times, options);
   return detail::select<PoseGroup::se3>(poses, times, options);
