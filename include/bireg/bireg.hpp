@@ -1,5 +1,8 @@
-// bireg: everything at once (the groups, the concept, geodesics and the
-// regression). Including only what you use compiles faster.
+// bireg: everything at once (the groups, the concept, geodesics, the
+// regression and the statistics built on it: means, covariances and
+// confidence regions, the trend test, robust fits, model selection and
+// local regression). The trajectory file formats (bireg/io/) are not
+// included. Including only what you use compiles faster.
 #pragma once
 
 #include "bireg/concept.hpp"
@@ -13,3 +16,15 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/confidence.hpp"
+#include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/distributions.hpp"
+#include "bireg/statistics/explained_variance.hpp"
+#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/mean.hpp"
+#include "bireg/statistics/model_selection.hpp"
+#include "bireg/statistics/permutation.hpp"
+#include "bireg/statistics/robust.hpp"
+#include "bireg/statistics/robust_loss.hpp"
+#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/trend_test.hpp"
