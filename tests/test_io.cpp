@@ -493,3 +493,68 @@ TEST_CASE("JSON numbers are never nan or inf", "[io]") {
   m << 1, std::nan(""), HUGE_VAL, 2;
   REQUIRE(bireg::io::json_matrix(m) == "[[1, null], [null, 2]]");
 }
+
+// Issue 36, defect 6: a trajectory turning through pi. q and -q are the
+// same rotation; choosing w >= 0 on every line flips the sign of (x, y, z)
+// between two nearby rotations either side of pi. Each written quaternion
+// must lie on the side of the previous line's (q_k . q_{k-1} >= 0), the
+// first with w >= 0, and every line must still read back as its pose.
+TEST_CASE("written quaternions keep their hemisphere through a half turn", "[io]") {
+  constexpr double kPi = 3.14159265358979323846;
+  for (const bool tilting_axis : {false, true}) {
+    CAPTURE(tilting_axis);
+    std::vector<SE3::Element> poses;
+    std::vector<SO3::Element> rotations;
+    std::vector<std::string> seconds, nanoseconds;
+    // From 0 to 2.2 pi (through pi, and through 2 pi where q reaches -1);
+    // step 0.01 pi, and an angle landing exactly on pi.
+    for (int k = 0; k <= 220; ++k) {
+      const double angle = 0.01 * kPi * k;
+      Eigen::Vector3d axis(1, 2, 3);
+      if (tilting_axis) axis += Eigen::Vector3d(std::sin(0.05 * k), 0, std::cos(0.03 * k));
+      axis.normalize();
+      rotations.push_back(Eigen::AngleAxisd(angle, axis).toRotationMatrix());
+      SE3::Element g = SE3::Element::Identity();
+      g.topLeftCorner<3, 3>() = rotations.back();
+      g.topRightCorner<3, 1>() = Eigen::Vector3d(0.1 * k, -0.02 * k, 1);
+      poses.push_back(g);
+      seconds.push_back(std::to_string(10 + k) + ".5");
+      nanoseconds.push_back(std::to_string(10 + k) + "500000000");
+    }
+    for (const Format format : {Format::tum, Format::euroc}) {
+      CAPTURE(bireg::io::to_string(format));
+      const bool euroc = format == Format::euroc;
+      const auto times = timestamps_of(euroc ? nanoseconds : seconds, bireg::io::time_unit(format));
+      const std::string se3 = bireg::io::format_trajectory<SE3>(format, format, times, poses);
+      const std::string so3 = bireg::io::format_trajectory<SO3>(format, format, times, rotations);
+      for (const std::string* text : {&se3, &so3}) {
+        std::istringstream lines(*text);
+        std::string line;
+        if (euroc) std::getline(lines, line);  // the header
+        std::vector<Eigen::Vector4d> written;  // (w, x, y, z)
+        while (std::getline(lines, line)) {
+          for (char& c : line)
+            if (c == ',') c = ' ';
+          std::istringstream numbers(line);
+          std::vector<double> v;
+          for (double x; numbers >> x;)
+            v.push_back(x);
+          REQUIRE(v.size() == (euroc ? 17u : 8u));
+          written.push_back(euroc ? Eigen::Vector4d(v[4], v[5], v[6], v[7])
+                                  : Eigen::Vector4d(v[7], v[4], v[5], v[6]));
+        }
+        REQUIRE(written.size() == poses.size());
+        REQUIRE(written.front()[0] >= 0);
+        for (std::size_t k = 0; k < written.size(); ++k) {
+          CAPTURE(k);
+          const Eigen::Quaterniond q(written[k][0], written[k][1], written[k][2], written[k][3]);
+          REQUIRE(std::abs(q.norm() - 1) <= 1e-15 * 8);
+          REQUIRE((q.toRotationMatrix() - rotations[k]).norm() <= 1e-14);
+          if (k > 0) REQUIRE(written[k].dot(written[k - 1]) >= 0);
+        }
+        // Through 2 pi the quaternion has turned to -1: w < 0 at the end.
+        REQUIRE(written.back()[0] < 0);
+      }
+    }
+  }
+}

@@ -8,6 +8,12 @@
 //           nanoseconds, position, quaternion w first, then velocity and
 //           biases, which a fitted pose does not have: written as 0;
 //   kitti   the 3x4 pose row-major, 12 numbers, single spaces, no time.
+// Quaternions (tum, euroc) stay in one hemisphere from line to line: q and
+// -q are the same rotation, and each line's quaternion is the one on the
+// side of the previous line's (q_k . q_{k-1} >= 0; the first has w >= 0),
+// so that a trajectory turning through pi does not flip sign between two
+// nearby rotations (evo and interpolating readers take the flip for a
+// full turn).
 // Timestamps are written exactly as they were read when the output's time
 // unit is the input's; converted exactly otherwise (seconds <-> nanoseconds).
 // Numbers are the shortest text that reads back to the same double; JSON
@@ -27,6 +33,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
@@ -85,10 +92,12 @@ inline std::string timestamp_text(const Timestamp& t, Format source, Format targ
 }
 
 // Appends one observation line in `format` (with its '\n'); `time` is the
-// timestamp text (unused by kitti).
+// timestamp text (unused by kitti). `previous` is the quaternion written on
+// the line before (empty for the first line): this line's is taken on its
+// side (q . previous >= 0) and stored in it, for the next line.
 template <class G>
 void append_observation(std::string& out, Format format, std::string_view time,
-                        const typename G::Element& g) {
+                        const typename G::Element& g, std::optional<Eigen::Quaterniond>& previous) {
   if (format == Format::matrix) {
     out += time;
     for (int r = 0; r < g.rows(); ++r) {
@@ -126,7 +135,9 @@ void append_observation(std::string& out, Format format, std::string_view time,
     out += '\n';
     return;
   }
-  const Eigen::Quaterniond q = SO3<double>::to_quaternion(rotation);
+  Eigen::Quaterniond q = SO3<double>::to_quaternion(rotation);
+  if (previous && q.coeffs().dot(previous->coeffs()) < 0) q.coeffs() = -q.coeffs();
+  previous = q;
   out += time;
   if (format == Format::tum) {
     for (double x : {translation[0], translation[1], translation[2], q.x(), q.y(), q.z(), q.w()})
@@ -137,6 +148,14 @@ void append_observation(std::string& out, Format format, std::string_view time,
     out += ",0,0,0,0,0,0,0,0,0";
   }
   out += '\n';
+}
+
+// One line on its own: its quaternion has w >= 0.
+template <class G>
+void append_observation(std::string& out, Format format, std::string_view time,
+                        const typename G::Element& g) {
+  std::optional<Eigen::Quaterniond> none;
+  append_observation<G>(out, format, time, g, none);
 }
 
 // Writes a trajectory to an open C stream, in blocks, and flushes it.
@@ -159,8 +178,10 @@ std::optional<std::string> write_trajectory(std::FILE* file, Format format, Form
   const auto failure = []() {
     return std::string("write error: ") + (errno != 0 ? std::strerror(errno) : "unknown");
   };
+  std::optional<Eigen::Quaterniond> previous;
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    append_observation<G>(buffer, format, timestamp_text(times[i], source, format), poses[i]);
+    append_observation<G>(buffer, format, timestamp_text(times[i], source, format), poses[i],
+                          previous);
     if (buffer.size() >= (std::size_t{1} << 20) && !flush_buffer()) return failure();
   }
   if (!flush_buffer()) return failure();
@@ -179,8 +200,11 @@ std::string format_trajectory(Format format, Format source, const std::vector<Ti
     throw std::invalid_argument("format_trajectory: " + unsupported_format_message<G>(format));
   }
   std::string out = header_line(format);
-  for (std::size_t i = 0; i < poses.size(); ++i)
-    append_observation<G>(out, format, timestamp_text(times[i], source, format), poses[i]);
+  std::optional<Eigen::Quaterniond> previous;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    append_observation<G>(out, format, timestamp_text(times[i], source, format), poses[i],
+                          previous);
+  }
   return out;
 }
 
