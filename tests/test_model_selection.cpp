@@ -1,6 +1,7 @@
 // Motion-model selection (statistics/model_selection.hpp): recovery of the
 // generating model on simulated scenes, invariance, nesting, degenerate input.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -390,4 +391,56 @@ TEST_CASE("rotation data: static or geodesic, recovered and invariant") {
   const auto none = bireg::select_static_or_geodesic<bireg::SO3d>(std::vector<Eigen::Matrix3d>{},
                                                                   std::vector<double>{});
   CHECK_FALSE(none.recommended.has_value());
+}
+
+// Issue 36, defect 6: the covariates in any indexable container with
+// size(), as every other entry point takes them (the fits, the mean, the
+// trend test), not only std::vector<double>. The same numbers give the
+// same answer, to the bit; a bad covariate is named by its index.
+TEST_CASE("covariates in std::array and Eigen::VectorXd", "[containers]") {
+  std::mt19937 rng(31);
+  const Scene scene = simulate(MotionModel::screw, rng);
+  std::array<double, kObservations> array_times{};
+  Eigen::VectorXd eigen_times(kObservations);
+  for (int i = 0; i < kObservations; ++i) {
+    array_times[static_cast<std::size_t>(i)] = scene.times[static_cast<std::size_t>(i)];
+    eigen_times[i] = scene.times[static_cast<std::size_t>(i)];
+  }
+  const auto base = bireg::select_motion_model(scene.poses, scene.times);
+  REQUIRE(base.ok());
+  REQUIRE(base.recommended == MotionModel::screw);
+  for (const bireg::ModelSelection& s : {bireg::select_motion_model(scene.poses, array_times),
+                                         bireg::select_motion_model(scene.poses, eigen_times)}) {
+    REQUIRE(s.ok());
+    REQUIRE(s.recommended == base.recommended);
+    REQUIRE(s.candidates.size() == base.candidates.size());
+    for (std::size_t c = 0; c < s.candidates.size(); ++c)
+      REQUIRE(s.candidates[c].criterion == base.candidates[c].criterion);
+  }
+  const auto by_vector = bireg::fit_motion_model(MotionModel::screw, scene.poses, scene.times);
+  const auto by_eigen = bireg::fit_motion_model(MotionModel::screw, scene.poses, eigen_times);
+  REQUIRE(by_vector.has_value());
+  REQUIRE(by_eigen.has_value());
+  REQUIRE((*by_eigen)(0.37) == (*by_vector)(0.37));
+
+  std::mt19937 rotation_rng(32);
+  const RotationScene rotations = rotation_scene(true, rotation_rng);
+  Eigen::VectorXd rotation_times(static_cast<Eigen::Index>(rotations.times.size()));
+  for (Eigen::Index i = 0; i < rotation_times.size(); ++i)
+    rotation_times[i] = rotations.times[static_cast<std::size_t>(i)];
+  const auto trend_base =
+      bireg::select_static_or_geodesic<bireg::SO3d>(rotations.rotations, rotations.times);
+  const auto trend_eigen =
+      bireg::select_static_or_geodesic<bireg::SO3d>(rotations.rotations, rotation_times);
+  REQUIRE(trend_base.ok());
+  REQUIRE(trend_eigen.recommended == trend_base.recommended);
+  REQUIRE(trend_eigen.candidates[1].criterion == trend_base.candidates[1].criterion);
+
+  // Refusals name the covariate in the caller's container.
+  Eigen::VectorXd bad = eigen_times;
+  bad[4] = std::nan("");
+  const auto refused = bireg::select_motion_model(scene.poses, bad);
+  REQUIRE(refused.status == bireg::SelectionStatus::invalid_input);
+  REQUIRE(refused.bad_index == 4);
+  REQUIRE(refused.message.find("covariate 4") != std::string::npos);
 }

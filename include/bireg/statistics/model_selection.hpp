@@ -324,6 +324,22 @@ std::optional<Rejection> check_covariates(std::size_t observations, const Times&
   return std::nullopt;
 }
 
+// The covariates as doubles, for the public entry points' overloads that
+// take any indexable container with size() (std::array, std::deque, Eigen
+// vectors, ...), as the fits do.
+template <class Times>
+std::vector<double> as_doubles(const Times& times) {
+  using Index = decltype(times.size());
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(times.size()));
+  for (Index i = 0; i < times.size(); ++i)
+    out.push_back(static_cast<double>(times[i]));
+  return out;
+}
+
+template <class Times>
+constexpr bool kOtherTimes = !std::is_same_v<std::decay_t<Times>, std::vector<double>>;
+
 // Lengths, covariates, then every observation finite and an element of G
 // (to the default element tolerance); the first at fault is named.
 template <class G, class Observations>
@@ -843,6 +859,16 @@ TrendSelection<G> select_static_or_geodesic(const Observations& observations,
   return selection;
 }
 
+// The same with covariates in any indexable container with size()
+// (std::array, Eigen::VectorXd, ...), read as doubles.
+template <class G, class Observations, class Times,
+          std::enable_if_t<model_selection_detail::kOtherTimes<Times>, int> = 0>
+TrendSelection<G> select_static_or_geodesic(const Observations& observations, const Times& times,
+                                            const ModelSelectionOptions& options = {}) {
+  return select_static_or_geodesic<G>(observations, model_selection_detail::as_doubles(times),
+                                      options);
+}
+
 // One candidate fitted alone: its prediction P(t) at any covariate, or
 // nothing if its fit failed, the input is refused (as select_motion_model
 // refuses it: a pose that is not an element of `group`, a covariate that
@@ -860,6 +886,15 @@ std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses&
   }
   if (detail::check_input<SE3d>(poses, times, 1)) return std::nullopt;
   return detail::fit_model<PoseGroup::se3>(model, poses, times);
+}
+
+// The same with covariates in any indexable container with size().
+template <class Poses, class Times,
+          std::enable_if_t<model_selection_detail::kOtherTimes<Times>, int> = 0>
+std::optional<MotionPrediction> fit_motion_model(MotionModel model, const Poses& poses,
+                                                 const Times& times,
+                                                 PoseGroup group = PoseGroup::se3) {
+  return fit_motion_model(model, poses, model_selection_detail::as_doubles(times), group);
 }
 
 // Compare the pose-motion models on `poses` (indexable 4x4 matrices with
@@ -885,6 +920,15 @@ ModelSelection select_motion_model(const Poses& poses, const std::vector<double>
   if (options.group == PoseGroup::sim3)
     return detail::select<PoseGroup::sim3>(poses, times, options);
   return detail::select<PoseGroup::se3>(poses, times, options);
+}
+
+// The same with covariates in any indexable container with size()
+// (std::array, std::deque, Eigen::VectorXd, ...), read as doubles.
+template <class Poses, class Times,
+          std::enable_if_t<model_selection_detail::kOtherTimes<Times>, int> = 0>
+ModelSelection select_motion_model(const Poses& poses, const Times& times,
+                                   const ModelSelectionOptions& options = {}) {
+  return select_motion_model(poses, model_selection_detail::as_doubles(times), options);
 }
 
 }  // namespace bireg
