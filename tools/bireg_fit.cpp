@@ -23,7 +23,10 @@
 // --loss fits robustly (bireg/statistics/robust.hpp: reweighting on the
 // residuals' Mahalanobis distances, C defaulting to 95% Gaussian
 // efficiency); the JSON then has a "robust" object with the flagged
-// outliers' input line numbers, and exit code 3 when it did not converge.
+// outliers' input line numbers and the last weighted fit's "fit_status",
+// and exit code 3 when it did not converge: the top-level "status" is then
+// the robust one (max_rounds, too_few_good, singular_scatter) if the last
+// weighted fit itself converged.
 //
 // For SO3 and SE3 (refused for the other groups, with a message):
 // --confidence LEVEL (0 < LEVEL < 1) adds a "confidence" object: the body
@@ -56,7 +59,8 @@
 //
 // Prints one JSON object on stdout. Exit codes: 0 converged, 2 invalid input
 // or usage (one line on stderr naming file, line and problem), 3 the fit did
-// not converge (the JSON is still printed, with its status), 4 the output
+// not converge (the JSON is still printed, with the status that decided the
+// exit code as its top-level "status", and one line on stderr says why), 4 the output
 // could not be written (disk full, closed pipe, ...), 5 the fit converged
 // but a requested statistic is undefined (the JSON says why).
 #include <cmath>

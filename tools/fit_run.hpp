@@ -30,6 +30,27 @@ inline int fail(const std::string& message) {
   return kExitInvalid;
 }
 
+// Why a fit that did not converge stopped: the status named and explained,
+// for the line on stderr that goes with exit code 3.
+inline std::string not_converged_reason(bireg::Status status) {
+  switch (status) {
+    case bireg::Status::max_iterations:
+      return "the iteration limit (--max-iter) was reached first";
+    case bireg::Status::diverged:
+      return "the steps grew without bound";
+    case bireg::Status::series_diverged:
+      return "a step would leave the region where the series of --method series converges";
+    case bireg::Status::no_descent:
+      return "no step reduces the estimating equations: the data lie outside the region "
+             "where the estimator is defined (e.g. a turn of more than pi)";
+    case bireg::Status::converged:
+    case bireg::Status::rounding_floor:
+    case bireg::Status::invalid_input:
+      break;
+  }
+  return "the fit did not converge";
+}
+
 // The groups whose fits get --confidence, --permutations and --output-band.
 template <class G>
 constexpr bool kHasStatistics =
@@ -182,6 +203,13 @@ int run(const FitCommand& command) {
                  "(or it is a gross outlier), outside the estimator's domain\n",
                  bireg_cli::where(name, farthest_line).c_str(), double(d.largest_residual_angle));
   }
+  // The status that decides the exit code is the top-level "status": the
+  // fit's own when it did not converge; else, with --loss, the robust
+  // reweighting's (max_rounds, too_few_good, singular_scatter, ...), whose
+  // last weighted fit may well have converged ("robust": "fit_status").
+  const bool robust_failed = robust && !robust->ok() && result.ok();
+  const char* status =
+      robust_failed ? bireg::to_string(robust->status) : bireg::to_string(result.status);
   const double final_step = result.step_norms.empty() ? 0.0 : result.step_norms.back();
   const std::string projection =
       bireg_cli::projection_json(command.input.project, trajectory.projection_correction);
@@ -200,15 +228,14 @@ int run(const FitCommand& command) {
       io::json_matrix(result.geodesic->start()).c_str(),
       io::json_matrix(result.geodesic->end()).c_str(),
       io::render_timestamp(trajectory.origin, io::TimeUnit::seconds).c_str(),
-      io::render_timestamp(trajectory.last, io::TimeUnit::seconds).c_str(),
-      bireg::to_string(result.status), result.iterations, json_number(final_step).c_str(),
-      json_number(d.mu_min).c_str(), json_number(d.mu_max).c_str(),
-      json_number(d.step_size).c_str(), json_number(d.contraction_factor).c_str(),
-      bireg::to_string(command.method), d.series_order, bireg::to_string(command.solver),
-      d.backtracks, json_number(d.force_norm).c_str(), json_number(d.residual_rms).c_str(),
-      json_number(d.residual_rms_about_mean).c_str(), json_number(d.explained_variance).c_str(),
-      json_number(d.largest_residual_angle).c_str(), static_cast<unsigned long long>(farthest_line),
-      d.beyond_domain ? "true" : "false");
+      io::render_timestamp(trajectory.last, io::TimeUnit::seconds).c_str(), status,
+      result.iterations, json_number(final_step).c_str(), json_number(d.mu_min).c_str(),
+      json_number(d.mu_max).c_str(), json_number(d.step_size).c_str(),
+      json_number(d.contraction_factor).c_str(), bireg::to_string(command.method), d.series_order,
+      bireg::to_string(command.solver), d.backtracks, json_number(d.force_norm).c_str(),
+      json_number(d.residual_rms).c_str(), json_number(d.residual_rms_about_mean).c_str(),
+      json_number(d.explained_variance).c_str(), json_number(d.largest_residual_angle).c_str(),
+      static_cast<unsigned long long>(farthest_line), d.beyond_domain ? "true" : "false");
   if (robust) {
     std::string lines;  // the flagged observations' line numbers in the input
     for (std::size_t i : robust->outliers) {
@@ -216,9 +243,10 @@ int run(const FitCommand& command) {
     }
     std::printf(
         ",\n \"robust\": {\"loss\": \"%s\", \"loss_scale\": %s, \"status\": \"%s\", "
-        "\"rounds\": %d, \"outlier_lines\": [%s]}",
+        "\"fit_status\": \"%s\", \"rounds\": %d, \"outlier_lines\": [%s]}",
         bireg::to_string(robust->loss), json_number(robust->loss_scale).c_str(),
-        bireg::to_string(robust->status), robust->rounds, lines.c_str());
+        bireg::to_string(robust->status), bireg::to_string(result.status), robust->rounds,
+        lines.c_str());
   }
   if (!confidence_json.empty()) std::printf(",\n \"confidence\": %s", confidence_json.c_str());
   if (!trend_json.empty()) std::printf(",\n \"trend_test\": %s", trend_json.c_str());
@@ -229,7 +257,15 @@ int run(const FitCommand& command) {
                  errno != 0 ? std::strerror(errno) : "unknown");
     return kExitWriteError;
   }
-  if (!result.ok() || (robust && !robust->ok())) return kExitNotConverged;
+  if (!result.ok() || (robust && !robust->ok())) {
+    // Exit code 3 says why on stderr, in the top-level status's words.
+    const std::string why = robust_failed ? "the robust fit did not converge (" +
+                                                std::string(status) + "): " + robust->message
+                                          : "the fit did not converge (" + std::string(status) +
+                                                "): " + not_converged_reason(result.status);
+    std::fprintf(stderr, "bireg_fit: %s: %s; exit code 3\n", name.c_str(), why.c_str());
+    return kExitNotConverged;
+  }
   return undefined ? kExitUndefined : 0;
 }
 

@@ -144,8 +144,8 @@ MUTANTS = [
            ["test_io"],
            "range check inverted: underflow refused, overflow not named"),
     Mutant("CL1", "tools/fit_run.hpp",
-           "if (!result.ok() || (robust && !robust->ok())) return kExitNotConverged;",
-           "if (!result.ok() && (robust && !robust->ok())) return kExitNotConverged;",
+           "if (!result.ok() || (robust && !robust->ok())) {",
+           "if (!result.ok() && (robust && !robust->ok())) {",
            ["test_fit_tool"],
            "exit code 0 for a fit that did not converge"),
 ]
