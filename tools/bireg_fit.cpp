@@ -10,6 +10,9 @@
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]
 //             [--threads N] FILE|-
 //
+// An option given twice (or under both of its spellings, --tol and
+// --tolerance) is refused with exit code 2.
+//
 // The formats, their detection when --format is omitted, --times and
 // --project are described in include/bireg/io/formats.hpp and README.md.
 // SL3 and GLp3 (3x3) read the matrix format only; Sim3 (4x4 [s R t; 0 1])
@@ -66,6 +69,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "bireg/groups/matrix_group.hpp"
@@ -97,9 +101,20 @@ constexpr const char* kUsage =
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
     "                 [--threads N] FILE|-\n";
 
+// The option an argument spells, its library alias mapped to the short
+// name, so that --tol and --tolerance count as one option.
+std::string canonical_option(const std::string& arg) {
+  if (arg == "--series-order") return "--order";
+  if (arg == "--step-size") return "--step";
+  if (arg == "--tolerance") return "--tol";
+  if (arg == "--max-iterations") return "--max-iter";
+  return arg;
+}
+
 // Parses argv into `command`; returns an error message or nothing.
 std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCommand& command) {
   bool order_given = false;
+  std::set<std::string> given;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const auto value = [&]() -> std::optional<std::string> {
@@ -110,6 +125,11 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
       if (!command.input.path.empty()) return "more than one input file";
       command.input.path = arg;
       continue;
+    }
+    const std::string option = canonical_option(arg);
+    if (!given.insert(option).second) {
+      return "option " + option + " given more than once" +
+             (option != arg ? " (" + arg + " is another spelling of it)" : std::string());
     }
     if (arg == "--project") {
       command.input.project = true;
