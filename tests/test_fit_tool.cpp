@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -30,6 +31,7 @@
 #include "bireg/statistics/explained_variance.hpp"
 #include "bireg/statistics/mean.hpp"
 #include "bireg/statistics/trend_test.hpp"
+#include "bireg/version.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 #include "tool_runner.hpp"
@@ -263,6 +265,92 @@ TEST_CASE("bireg_fit refuses an option given more than once, naming it", "[tool]
   const Run once = run_tool(std::string("--group SO3 --tol 1e-8 --max-iter 50 --format matrix ") +
                             "\"" + data("so3_small.csv") + "\"");
   REQUIRE(once.exit_code == 0);
+}
+
+// Issue 36: --help and --version, as users of command-line tools expect.
+TEST_CASE("bireg_fit --help lists every option with its default, and the exit codes", "[tool]") {
+  for (const std::string args : {"--help", "-h", "--group SO3 --help"}) {
+    CAPTURE(args);
+    const Run run = run_tool(args);
+    CAPTURE(run.out, run.err);
+    REQUIRE(run.exit_code == 0);
+    REQUIRE(run.err.empty());
+    REQUIRE(run.out.rfind("usage: bireg_fit", 0) == 0);
+    // Every option the tool takes, on one line of its own that says what it
+    // does and its default (or that it is required).
+    const std::vector<std::string> options = {"--group",
+                                              "--format",
+                                              "--times",
+                                              "--project",
+                                              "--method",
+                                              "--order",
+                                              "--solver",
+                                              "--step",
+                                              "--tol",
+                                              "--max-iter",
+                                              "--loss",
+                                              "--loss-scale",
+                                              "--confidence",
+                                              "--permutations",
+                                              "--seed",
+                                              "--output-band",
+                                              "--output-trajectory",
+                                              "--output-format",
+                                              "--threads",
+                                              "--help",
+                                              "--version"};
+    std::map<std::string, std::string> line_of;
+    std::istringstream lines(run.out);
+    for (std::string line; std::getline(lines, line);) {
+      const std::size_t start = line.find_first_not_of(' ');
+      if (start == 0 || start == std::string::npos || line.compare(start, 2, "--") != 0) continue;
+      const std::string option = line.substr(start, line.find_first_of(" ,", start) - start);
+      REQUIRE(line_of.count(option) == 0);
+      line_of[option] = line;
+    }
+    for (const std::string& option : options) {
+      CAPTURE(option);
+      REQUIRE(line_of.count(option) == 1);
+      const std::string& line = line_of[option];
+      if (option != "--help" && option != "--version") {
+        REQUIRE((line.find("(default") != std::string::npos ||
+                 line.find("(required") != std::string::npos));
+      }
+      // A meaning, not just the option's name and value.
+      REQUIRE(line.size() > option.size() + 30);
+    }
+    REQUIRE(line_of.size() == options.size());
+    // The defaults stated are those the fit uses: the library's.
+    const bireg::RegressionOptions<double> library;
+    const auto default_in = [&](const std::string& option) {
+      const std::string& line = line_of[option];
+      const std::size_t at = line.find("(default ");
+      REQUIRE(at != std::string::npos);
+      const std::size_t start = at + 9;
+      return line.substr(start, line.find(')', start) - start);
+    };
+    REQUIRE(std::strtod(default_in("--tol").c_str(), nullptr) == library.tolerance);
+    REQUIRE(std::strtod(default_in("--max-iter").c_str(), nullptr) == library.max_iterations);
+    REQUIRE(default_in("--method") == bireg::to_string(library.method));
+    REQUIRE(default_in("--solver") == bireg::to_string(library.solver));
+    // The exit codes, each on its own line.
+    REQUIRE(run.out.find("Exit codes") != std::string::npos);
+    for (const char* code : {"\n  0 ", "\n  2 ", "\n  3 ", "\n  4 ", "\n  5 "}) {
+      CAPTURE(code);
+      REQUIRE(run.out.find(code) != std::string::npos);
+    }
+  }
+}
+
+TEST_CASE("bireg_fit --version prints the library's version", "[tool]") {
+  for (const std::string args : {"--version", "--group SO3 --version"}) {
+    CAPTURE(args);
+    const Run run = run_tool(args);
+    CAPTURE(run.out, run.err);
+    REQUIRE(run.exit_code == 0);
+    REQUIRE(run.err.empty());
+    REQUIRE(run.out == std::string("bireg_fit ") + bireg::version + "\n");
+  }
 }
 
 TEST_CASE("bireg_fit exits with 3 and still prints the JSON when the fit does not converge",

@@ -9,9 +9,12 @@
 //             [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]
 //             [--threads N] FILE|-
+//   bireg_fit --help | --version
 //
-// An option given twice (or under both of its spellings, --tol and
-// --tolerance) is refused with exit code 2.
+// --help prints the usage, every option with its default and meaning, and
+// the exit codes on stdout; --version prints "bireg_fit <version>"
+// (bireg/version.hpp); both exit 0. An option given twice (or under both
+// of its spellings, --tol and --tolerance) is refused with exit code 2.
 //
 // The formats, their detection when --format is omitted, --times and
 // --project are described in include/bireg/io/formats.hpp and README.md.
@@ -78,6 +81,8 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/regression/options.hpp"
+#include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
 #include "fit_auto.hpp"
@@ -99,7 +104,73 @@ constexpr const char* kUsage =
     "                 [--loss huber|cauchy|tukey [--loss-scale C]]\n"
     "                 [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]\n"
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
-    "                 [--threads N] FILE|-\n";
+    "                 [--threads N] FILE|-\n"
+    "       bireg_fit --help | --version\n";
+
+// --help: the usage, every option on one line with its meaning and default
+// (the defaults shown are the ones the tool uses), and the exit codes.
+std::string help_text() {
+  const bireg_cli::FitCommand defaults;
+  const std::string tolerance =
+      bireg::io::format_double(bireg::RegressionOptions<double>().tolerance);
+  std::string text = kUsage;
+  text +=
+      "\nFits a bi-invariant geodesic to the trajectory in FILE (- for standard input) and\n"
+      "prints one JSON object on stdout (README.md, \"bireg_fit\").\n"
+      "\nOptions (each at most once):\n"
+      "  --group G                 SO2 SO3 SE2 SE3 Sim3 SL3 GLp3, or auto: model of SE3/Sim3 poses "
+      "(required)\n"
+      "  --format F                input format: matrix, tum, euroc, kitti (default detected from "
+      "the content)\n"
+      "  --times FILE              KITTI timestamps, one line per pose (default the frame index)\n"
+      "  --project                 normalise quaternions, re-orthonormalise rotations (default "
+      "off)\n"
+      "  --method M                exact, series, series_adaptive: the inverse differentials "
+      "(default " +
+      std::string(bireg::to_string(defaults.method)) +
+      ")\n"
+      "  --order M                 series order 1.." +
+      std::to_string(bireg::kMaxSeriesOrder) +
+      ", needed by --method series only (default none)\n"
+      "  --solver S                paper, optimal_linear, preconditioned, gauss_newton: step rule "
+      "(default " +
+      std::string(bireg::to_string(defaults.solver)) +
+      ")\n"
+      "  --step LAMBDA             step size of --solver paper, below 2/mu_max (default 1/mu_max)\n"
+      "  --tol X                   stop at a step norm <= X; 0: run --max-iter; or --tolerance "
+      "(default " +
+      tolerance +
+      ")\n"
+      "  --max-iter K              iteration limit; also spelt --max-iterations (default " +
+      std::to_string(defaults.max_iterations) +
+      ")\n"
+      "  --loss L                  huber, cauchy, tukey: fit robustly and flag outliers (default "
+      "none)\n"
+      "  --loss-scale C            the loss's constant, Mahalanobis units (default 95% "
+      "efficiency)\n"
+      "  --confidence LEVEL        add velocity, standard errors, covariances, R^2; SO3, SE3 "
+      "(default none)\n"
+      "  --permutations B          add the permutation trend test, B >= 1; SO3, SE3 (default "
+      "none)\n"
+      "  --seed S                  the trend test's random seed, with --permutations (default 0)\n"
+      "  --output-band FILE        CSV of fitted poses and confidence half-widths; SO3, SE3 "
+      "(default none)\n"
+      "  --output-trajectory FILE  write the fitted geodesic at every input time (default none)\n"
+      "  --output-format F         the format of --output-trajectory (default the input's)\n"
+      "  --threads N               threads; the output does not depend on N (default every core: " +
+      std::to_string(defaults.threads) +
+      ")\n"
+      "  --help, -h                print this help on stdout and exit 0\n"
+      "  --version                 print \"bireg_fit <version>\" on stdout and exit 0\n"
+      "\nExit codes:\n"
+      "  0  the fit converged (and every statistic asked for is defined)\n"
+      "  2  invalid input or usage: one line on stderr names the file, line and problem\n"
+      "  3  the fit, or with --loss the robust reweighting, did not converge: the JSON is\n"
+      "     still printed, its \"status\" says which, and one line on stderr says why\n"
+      "  4  the output could not be written (disk full, closed pipe, ...)\n"
+      "  5  the fit converged but a statistic asked for is undefined (the JSON says why)\n";
+  return text;
+}
 
 // The option an argument spells, its library alias mapped to the short
 // name, so that --tol and --tolerance count as one option.
@@ -111,8 +182,14 @@ std::string canonical_option(const std::string& arg) {
   return arg;
 }
 
-// Parses argv into `command`; returns an error message or nothing.
-std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCommand& command) {
+// What the command line asks for besides a fit.
+enum class Request { fit, help, version };
+
+// Parses argv into `command`; returns an error message or nothing. --help
+// and --version, where an option may stand, end the parsing and set
+// `request` (the options before them must be valid).
+std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCommand& command,
+                                         Request& request) {
   bool order_given = false;
   std::set<std::string> given;
   for (int i = 1; i < argc; ++i) {
@@ -125,6 +202,10 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
       if (!command.input.path.empty()) return "more than one input file";
       command.input.path = arg;
       continue;
+    }
+    if (arg == "--help" || arg == "-h" || arg == "--version") {
+      request = arg == "--version" ? Request::version : Request::help;
+      return std::nullopt;
     }
     const std::string option = canonical_option(arg);
     if (!given.insert(option).second) {
@@ -240,9 +321,19 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
 
 int bireg_cli::fit_main(int argc, char** argv) {
   bireg_cli::FitCommand command;
-  if (const auto error = parse_command(argc, argv, command)) {
+  Request request = Request::fit;
+  if (const auto error = parse_command(argc, argv, command, request)) {
     std::fprintf(stderr, "bireg_fit: %s\n%s", error->c_str(), kUsage);
     return kExitInvalid;
+  }
+  if (request != Request::fit) {
+    const std::string text =
+        request == Request::help ? help_text() : std::string("bireg_fit ") + bireg::version + "\n";
+    if (std::fputs(text.c_str(), stdout) == EOF || std::fflush(stdout) != 0) {
+      std::fprintf(stderr, "bireg_fit: <stdout>: write error\n");
+      return bireg_cli::kExitWriteError;
+    }
+    return 0;
   }
   if (command.group == "auto") {
     const bool fit_options = command.loss || command.confidence || command.permutations > 0 ||
