@@ -62,8 +62,8 @@ TEST_CASE("bireg/bireg.hpp includes the statistics", "[includes]") {
   const auto motion = [](const auto& poses, const auto& times) {
     return bireg::select_motion_model(poses, times);
   };
-  const auto local = [](const auto& observations, const auto& covariates) {
-    return bireg::LocalGeodesicRegression<G>().smooth(observations, covariates);
+  const auto local = [](const auto& options, const auto& observations, const auto& covariates) {
+    return bireg::LocalGeodesicRegression<G>(options).smooth(observations, covariates);
   };
   static_cast<void>(trend);
   static_cast<void>(motion);
