@@ -28,6 +28,15 @@
 //       reuse the force's half-angle sin and cos) fallback: the power series
 //       of math/psi_series.hpp.
 //
+//   Scalar turn_angle(const Element& g)             angle of g's rotation, in [0, pi]
+//       invariant under conjugation g -> h g h^{-1}, so a bound on the
+//       turn between two observations, turn_angle(f_a^{-1} f_b), is left
+//       and right invariant; the principal log is defined while it is below
+//       pi. Local regression caps its windows in it
+//       (statistics/local_window.hpp). fallback: none (has_turn_angle_v
+//       is false and windows are not capped); SO(2), SE(2), SO(3), SE(3)
+//       and Sim(3) provide it.
+//
 // J_r is the right Jacobian of exp: exp(x + dx) = exp(x) exp(J_r(x) dx +
 // O(dx^2)), with left-trivialised perturbations as everywhere in bireg.
 // Adding a group with a closed form therefore touches that group's header
@@ -70,6 +79,8 @@ template <class G>
 using ad_algebra_basis = decltype(G::ad_algebra_basis(std::declval<const Tangent<G>&>()));
 template <class G>
 using closed_form_psi = typename G::ClosedFormPsi;
+template <class G>
+using turn_angle = decltype(G::turn_angle(std::declval<const typename G::Element&>()));
 template <class Psi>
 using closed_form_min_angle = decltype(Psi::kMinAngle);
 template <class Psi>
@@ -92,6 +103,9 @@ inline constexpr bool provides_v = capability_detail::detect<G, Capability>::val
 
 template <class G>
 inline constexpr bool has_closed_form_psi_v = provides_v<G, capability_detail::closed_form_psi>;
+
+template <class G>
+inline constexpr bool has_turn_angle_v = provides_v<G, capability_detail::turn_angle>;
 
 // Spectral radius of ad_x.
 template <class G>

@@ -74,6 +74,14 @@ struct SE2 {
     return Tangent(diagonal * tx + half_theta * ty, -half_theta * tx + diagonal * ty, theta);
   }
 
+  // The angle of the rotation block, in [0, pi] (capabilities.hpp,
+  // turn_angle): conjugation by (R, t) leaves it unchanged.
+  static Scalar turn_angle(const Element& g) {
+    using std::abs;
+    using std::atan2;
+    return abs(atan2(g(1, 0), g(0, 0)));
+  }
+
   static Algebra hat(const Tangent& x) {
     Algebra m = Algebra::Zero();
     m(0, 1) = -x[2];

@@ -67,6 +67,12 @@ struct SE3 {
     return g;
   }
 
+  // The angle of the rotation block, in [0, pi] (capabilities.hpp,
+  // turn_angle): conjugation by (R, t) conjugates the block by R.
+  static Scalar turn_angle(const Element& g) {
+    return Rotation::turn_angle(g.template topLeftCorner<3, 3>());
+  }
+
   // Principal logarithm: |omega| in [0, pi].
   static Tangent log(const Element& g) {
     const Vector3 omega = Rotation::log(g.template topLeftCorner<3, 3>());

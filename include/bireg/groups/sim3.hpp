@@ -312,6 +312,15 @@ struct Sim3 {
     return g;
   }
 
+  // The angle of R in the block s R, in [0, pi] (capabilities.hpp,
+  // turn_angle; the block is divided by s first, since SO3::turn_angle reads
+  // the trace of a rotation). Conjugation by (s', R', t') conjugates R by R'.
+  static Scalar turn_angle(const Element& g) {
+    using std::sqrt;
+    const Matrix3 scaled_rotation = g.template topLeftCorner<3, 3>();
+    return Rotation::turn_angle(scaled_rotation / sqrt(scale_squared(scaled_rotation)));
+  }
+
   // Principal logarithm: |omega| in [0, pi]. The scale is the RMS column
   // norm of the 3x3 block, which is exact on the group and the nearest
   // similarity's scale for slightly perturbed input.

@@ -48,6 +48,14 @@ struct SO2 {
     return Tangent(atan2(g(1, 0), g(0, 0)));
   }
 
+  // |theta| of the principal logarithm, in [0, pi] (capabilities.hpp,
+  // turn_angle): SO(2) is abelian, so every conjugate has the same angle.
+  static Scalar turn_angle(const Element& g) {
+    using std::abs;
+    using std::atan2;
+    return abs(atan2(g(1, 0), g(0, 0)));
+  }
+
   static Algebra hat(const Tangent& x) {
     Algebra m;
     m << Scalar(0), -x[0], x[0], Scalar(0);

@@ -158,6 +158,18 @@ struct SO3 {
     return (Scalar(2) * atan2(v_norm, w) / v_norm) * v;
   }
 
+  // The rotation angle of r, in [0, pi] (capabilities.hpp, turn_angle):
+  // atan2(sin theta, cos theta) from the antisymmetric part
+  // |vee(r - r^T)| = 2 sin theta and the trace 1 + 2 cos theta, accurate at
+  // every angle. Invariant under conjugation, r -> q r q^T.
+  static Scalar turn_angle(const Element& r) {
+    using std::atan2;
+    using std::sqrt;
+    const Tangent d(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));
+    const Scalar trace = r(0, 0) + r(1, 1) + r(2, 2);
+    return atan2(sqrt(d.squaredNorm()), trace - Scalar(1));
+  }
+
   static Algebra hat(const Tangent& omega) {
     Algebra m;
     m << Scalar(0), -omega[2], omega[1], omega[2], Scalar(0), -omega[0], -omega[1], omega[0],
