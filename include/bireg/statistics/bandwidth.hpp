@@ -1,0 +1,403 @@
+// bireg: the automatic bandwidth of local regression
+// (statistics/local_geodesic.hpp) by cross-validation, one choice for the
+// pose and one for the velocity (DESIGN.md section 5).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "bireg/statistics/local_geodesic.hpp"
+
+namespace bireg {
+
+// The automatic bandwidth: two cross-validation curves over a grid, one
+// for the pose and one for the velocity, and their minimisers.
+template <class Scalar>
+struct BandwidthSelection {
+  // The admissible grid value with the smallest criterion (0: none).
+  Scalar bandwidth = 0;           // for the pose
+  Scalar velocity_bandwidth = 0;  // for the velocity
+  std::vector<Scalar> grid;       // ascending
+  // Per grid value: the generalised variance det(S_h)^(1/d) of the
+  // cross-validation errors, S_h = (1/M) sum e_i e_i^T over the M
+  // observations compared (below). Left invariant; right translation
+  // multiplies every S_h by the same Ad S Ad^T, so the ratios and the
+  // choice are right invariant on every group (DESIGN.md section 5).
+  // Infinite where the grid value was refused. `criterion` has the pose's
+  // leave-one-out errors, `velocity_criterion` the velocity's errors
+  // against the chords between neighbours, S_h corrected for the noise the
+  // two share (LocalGeodesicRegression::held_out, HoldOut::chords).
+  std::vector<Scalar> criterion;
+  std::vector<Scalar> velocity_criterion;
+  // The mean squared pose error (1/M) sum |e_i|^2, for reading: left
+  // invariant, right invariant only on compact groups (SO(n)).
+  std::vector<Scalar> mean_squared_error;
+  // Per grid value, the held-out queries whose local fit failed at every
+  // width, and the first of them; a grid value is refused only where
+  // more than a tenth of its queries failed (`refusals` says so), and
+  // otherwise compared with the others on the observations where every
+  // admissible value succeeded (`compared` of them).
+  std::vector<std::size_t> failures;
+  std::vector<std::size_t> velocity_failures;
+  std::vector<std::string> first_failures;
+  std::vector<std::string> refusals;  // why a grid value was refused, else empty
+  std::vector<std::string> velocity_refusals;
+  std::size_t compared = 0;
+  std::size_t velocity_compared = 0;
+  // Whether a choice is the grid's first or last value (the best value
+  // may lie beyond the grid), and everything a user should be told: a
+  // choice at the edge, most grid values refused, or why nothing could
+  // be chosen. Empty when there is nothing to say.
+  bool at_edge = false;
+  bool velocity_at_edge = false;
+  std::string message;
+  // The compatibility name of `refusals`' reasons and of the first
+  // failures: why a grid value failed or was refused, else empty.
+  std::vector<std::string> problems;
+  bool ok() const { return bandwidth > 0; }
+};
+
+namespace local_regression_detail {
+
+// A grid value whose held-out queries fail at more than this share of the
+// observations is refused: its curve would compare a different, easier
+// set of observations.
+inline constexpr double kMaxFailureShare = 0.1;
+
+// det(S)^(1/d), over S's numerical range where S is singular (the product
+// of its r eigenvalues above 1e-12 of the largest, to the power 1/r: the
+// pseudo-determinant, as the trend test uses for planar motion in SE(3),
+// whose errors have no component out of the plane); infinite when S is
+// zero or not finite.
+template <class G>
+typename G::Scalar generalised_variance(
+    const Eigen::Matrix<typename G::Scalar, G::dof, G::dof>& s) {
+  using Scalar = typename G::Scalar;
+  using std::exp;
+  using std::log;
+  const Scalar infinity = std::numeric_limits<Scalar>::infinity();
+  if (!s.allFinite()) return infinity;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<Scalar, G::dof, G::dof>> solver(
+      s, Eigen::EigenvaluesOnly);
+  const auto& eigenvalues = solver.eigenvalues();
+  const Scalar largest = eigenvalues.maxCoeff();
+  if (!(largest > 0)) return infinity;
+  Scalar sum_logs = 0;
+  int rank = 0;
+  for (int k = 0; k < eigenvalues.size(); ++k) {
+    if (!(eigenvalues[k] > Scalar(1e-12) * largest)) continue;
+    sum_logs += log(eigenvalues[k]);
+    ++rank;
+  }
+  return exp(sum_logs / Scalar(rank));
+}
+
+// The choice among `curves` (one HeldOut per grid value): refusals, the
+// common observations, the generalised variances, the minimiser's index
+// (or grid.size()). `mean_squared`, when given, receives (1/M) sum |e|^2.
+template <class G>
+std::size_t choose(const std::vector<HeldOut<G>>& curves, std::size_t n,
+                   std::vector<std::string>& refusals, std::vector<typename G::Scalar>& criteria,
+                   std::size_t& compared, std::vector<typename G::Scalar>* mean_squared,
+                   const Eigen::Matrix<typename G::Scalar, G::dof, G::dof>* noise = nullptr) {
+  using Scalar = typename G::Scalar;
+  using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  const std::size_t k = curves.size();
+  refusals.assign(k, std::string());
+  criteria.assign(k, std::numeric_limits<Scalar>::infinity());
+  if (mean_squared) mean_squared->assign(k, std::numeric_limits<Scalar>::infinity());
+  std::vector<char> common(n, 1);
+  for (std::size_t j = 0; j < k; ++j) {
+    const HeldOut<G>& c = curves[j];
+    if (!c.problem.empty()) {
+      refusals[j] = c.problem;
+      continue;
+    }
+    std::size_t attempted = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      attempted += c.ok[i] ? 1 : 0;
+    attempted += c.failures;
+    if (static_cast<double>(c.failures) > kMaxFailureShare * static_cast<double>(attempted)) {
+      refusals[j] = std::to_string(c.failures) + " of " + std::to_string(attempted) +
+                    " held-out fits failed (more than a tenth); the first: " + c.first_failure;
+      continue;
+    }
+    for (std::size_t i = 0; i < n; ++i)
+      common[i] = common[i] && c.ok[i];
+  }
+  compared = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    compared += common[i] ? 1 : 0;
+  if (compared == 0) return k;
+  std::size_t best = k;
+  for (std::size_t j = 0; j < k; ++j) {
+    if (!refusals[j].empty()) continue;
+    Scatter scatter = Scatter::Zero();
+    Scalar sum_squares = 0;
+    Scalar cross = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!common[i]) continue;
+      scatter.noalias() += curves[j].errors[i] * curves[j].errors[i].transpose();
+      sum_squares += curves[j].errors[i].squaredNorm();
+      if (noise) cross += curves[j].cross[i];
+    }
+    scatter /= Scalar(compared);
+    // HoldOut::chords: add back the shared noise, 2 mean(c_i) Sigma.
+    if (noise) scatter += (Scalar(2) * cross / Scalar(compared)) * *noise;
+    if (mean_squared) (*mean_squared)[j] = sum_squares / Scalar(compared);
+    const Scalar variance = generalised_variance<G>(scatter);
+    if (!std::isfinite(variance)) {
+      refusals[j] = "the scatter of the errors over " + std::to_string(compared) +
+                    " observations is zero or not finite: its generalised variance "
+                    "cannot rank this value";
+      continue;
+    }
+    criteria[j] = variance;
+    if (best == k || criteria[j] < criteria[best]) best = j;
+  }
+  return best;
+}
+
+// The noise covariance Sigma of observations f_i exp(e_i), from third
+// divided differences: for four consecutive observations (in covariate
+// order) with y_j = log(f_a^{-1} f_j) in the chart at the first, the
+// divided difference sum_j a_j y_j, a_j = 1 / prod_{k != j} (t_j - t_k),
+// vanishes on every quadratic in t, so on a smooth curve sampled densely
+// enough it is noise alone, with covariance (sum_j a_j^2) Sigma:
+// Sigma^ = mean of D D^T / sum a_j^2. Left invariant; maps by Ad under
+// right translation, like the errors it corrects. Zero with fewer than
+// four distinct covariates.
+template <class G, class Observations, class Covariates>
+Eigen::Matrix<typename G::Scalar, G::dof, G::dof> noise_scatter(const Observations& observations,
+                                                                const Covariates& covariates) {
+  using Scalar = typename G::Scalar;
+  using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  const std::size_t n = observations.size();
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return Scalar(covariates[a]) < Scalar(covariates[b]);
+  });
+  Scatter sum = Scatter::Zero();
+  std::size_t count = 0;
+  for (std::size_t i = 0; i + 3 < n; ++i) {
+    Scalar t[4];
+    for (int j = 0; j < 4; ++j)
+      t[j] = Scalar(covariates[order[i + static_cast<std::size_t>(j)]]);
+    if (!(t[0] < t[1] && t[1] < t[2] && t[2] < t[3])) continue;
+    const typename G::Element base_inverse = G::inverse(observations[order[i]]);
+    typename G::Tangent difference = G::Tangent::Zero();
+    Scalar squares = 0;
+    for (int j = 0; j < 4; ++j) {
+      Scalar a = 1;
+      for (int k = 0; k < 4; ++k) {
+        if (k != j) a /= t[j] - t[k];
+      }
+      squares += a * a;
+      if (j > 0) {
+        difference += a * G::log(G::compose(base_inverse,
+                                            observations[order[i + static_cast<std::size_t>(j)]]));
+      }
+    }
+    if (!(squares > 0) || !difference.allFinite()) continue;
+    sum.noalias() += difference * difference.transpose() / squares;
+    ++count;
+  }
+  if (count == 0) return Scatter::Zero();
+  return sum / Scalar(count);
+}
+
+}  // namespace local_regression_detail
+
+// Cross-validation over `grid` (options.bandwidth is ignored): for each
+// value the pose's leave-one-out errors and the velocity's errors against
+// the chords (LocalGeodesicRegression::held_out), and the minimiser of
+// each curve. The bandwidth that predicts the pose best is narrower than
+// the one that estimates its derivative best (a derivative's optimal
+// bandwidth shrinks more slowly with the noise), hence two choices.
+// `progress`, when set, is called with (done, total) after each held-out
+// pass (2 per grid value). Cost: two local fits per observation per grid
+// value evaluated, each over its window; windows are capped in turn
+// (Options::max_turn) and in the kernel's support, and the values past
+// both curves' minima are skipped (below), so the widest values, O(N^2)
+// each on slow motion over a long range, are seldom reached.
+template <class G, class Observations, class Covariates>
+BandwidthSelection<typename G::Scalar> select_bandwidth(
+    const Observations& observations, const Covariates& covariates,
+    LocalRegressionOptions<typename G::Scalar> options, const std::vector<typename G::Scalar>& grid,
+    const std::function<void(std::size_t, std::size_t)>& progress = {}) {
+  using Scalar = typename G::Scalar;
+  BandwidthSelection<Scalar> selection;
+  selection.grid = grid;
+  std::sort(selection.grid.begin(), selection.grid.end());
+  const std::size_t k = selection.grid.size();
+  const std::size_t n = observations.size();
+  if (k == 0) {
+    selection.message = "the bandwidth grid is empty";
+    return selection;
+  }
+  options.standard_errors = false;
+  using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  // Computed once the first held-out pass has checked the input.
+  Scatter noise = Scatter::Zero();
+  bool noise_ready = false;
+  // The curves are evaluated in ascending bandwidth, and the rest of the
+  // grid is skipped once neither has improved on its smallest value for
+  // kRisesBeforeStop values in a row (each judged provisionally, on its own
+  // successes): past their minimum the widest windows cost the most and
+  // cannot win.
+  constexpr std::size_t kRisesBeforeStop = 4;
+  const auto provisional = [n](const HeldOut<G>& c, const Scatter* correction) {
+    Scatter scatter = Scatter::Zero();
+    Scalar cross = 0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; c.problem.empty() && i < n; ++i) {
+      if (!c.ok[i]) continue;
+      scatter.noalias() += c.errors[i] * c.errors[i].transpose();
+      if (correction) cross += c.cross[i];
+      ++count;
+    }
+    // As choose() refuses: none compared, or too many failures.
+    const double attempted = static_cast<double>(count + c.failures);
+    if (count == 0 ||
+        static_cast<double>(c.failures) > local_regression_detail::kMaxFailureShare * attempted) {
+      return std::numeric_limits<Scalar>::infinity();
+    }
+    scatter /= Scalar(count);
+    if (correction) scatter += (Scalar(2) * cross / Scalar(count)) * *correction;
+    return local_regression_detail::generalised_variance<G>(scatter);
+  };
+  Scalar best_pose = std::numeric_limits<Scalar>::infinity();
+  Scalar best_velocity = best_pose;
+  std::size_t rises = 0;
+  std::vector<HeldOut<G>> poses, velocities;
+  for (std::size_t j = 0; j < k; ++j) {
+    if (rises >= kRisesBeforeStop) {
+      HeldOut<G> skipped;
+      skipped.problem = "not evaluated: neither criterion improved for " +
+                        std::to_string(kRisesBeforeStop) + " smaller bandwidths";
+      poses.push_back(skipped);
+      velocities.push_back(skipped);
+    } else {
+      options.bandwidth = selection.grid[j];
+      const LocalGeodesicRegression<G> smoother(options);
+      poses.push_back(smoother.held_out(observations, covariates, HoldOut::one));
+      if (progress) progress(2 * j + 1, 2 * k);
+      if (!noise_ready && poses.back().problem.empty()) {
+        noise = local_regression_detail::noise_scatter<G>(observations, covariates);
+        noise_ready = true;
+      }
+      velocities.push_back(smoother.held_out(observations, covariates, HoldOut::chords));
+      if (progress) progress(2 * j + 2, 2 * k);
+      const Scalar pose = provisional(poses.back(), nullptr);
+      const Scalar velocity = provisional(velocities.back(), &noise);
+      const bool improved = pose < best_pose || velocity < best_velocity;
+      best_pose = std::min(best_pose, pose);
+      best_velocity = std::min(best_velocity, velocity);
+      const bool started = best_pose < std::numeric_limits<Scalar>::infinity() &&
+                           best_velocity < std::numeric_limits<Scalar>::infinity();
+      rises = improved || !started ? 0 : rises + 1;
+    }
+    selection.failures.push_back(poses.back().failures);
+    selection.velocity_failures.push_back(velocities.back().failures);
+    selection.first_failures.push_back(poses.back().problem.empty() ? poses.back().first_failure
+                                                                    : poses.back().problem);
+  }
+  if (progress) progress(2 * k, 2 * k);
+  const std::size_t pose_best =
+      local_regression_detail::choose<G>(poses, n, selection.refusals, selection.criterion,
+                                         selection.compared, &selection.mean_squared_error);
+  const std::size_t velocity_best = local_regression_detail::choose<G>(
+      velocities, n, selection.velocity_refusals, selection.velocity_criterion,
+      selection.velocity_compared, nullptr, &noise);
+  selection.problems = selection.refusals;
+  for (std::size_t j = 0; j < k; ++j) {
+    if (selection.problems[j].empty()) selection.problems[j] = selection.first_failures[j];
+  }
+  std::size_t refused = 0;  // for a stated reason, not skipped
+  for (const std::string& r : selection.refusals)
+    refused += r.empty() || r.rfind("not evaluated", 0) == 0 ? 0 : 1;
+  const auto text = [](Scalar h) {
+    std::ostringstream out;
+    out.precision(6);
+    out << h;
+    return out.str();
+  };
+  if (pose_best == k) {
+    selection.message = "no bandwidth from " + text(selection.grid.front()) + " to " +
+                        text(selection.grid.back()) +
+                        " could be ranked (the first: " + selection.refusals.front() + ")";
+    return selection;
+  }
+  selection.bandwidth = selection.grid[pose_best];
+  selection.at_edge = k > 1 && (pose_best == 0 || pose_best + 1 == k);
+  // The velocity falls back to the pose's choice where its own curve has
+  // no admissible value (fewer than three observations, or noise that
+  // swamps the chords' correction).
+  selection.velocity_bandwidth =
+      velocity_best == k ? selection.bandwidth : selection.grid[velocity_best];
+  selection.velocity_at_edge =
+      velocity_best != k && k > 1 && (velocity_best == 0 || velocity_best + 1 == k);
+  std::string notes;
+  if (selection.at_edge) {
+    notes += std::string("the pose's choice is the grid's ") +
+             (pose_best == 0 ? "smallest" : "largest") + " value, " + text(selection.bandwidth) +
+             ": the best bandwidth may lie beyond the grid";
+  }
+  if (selection.velocity_at_edge) {
+    notes += std::string(notes.empty() ? "" : "; ") + "the velocity's choice is the grid's " +
+             (velocity_best == 0 ? "smallest" : "largest") + " value, " +
+             text(selection.velocity_bandwidth);
+  }
+  if (velocity_best == k) {
+    notes += std::string(notes.empty() ? "" : "; ") +
+             "no bandwidth could be ranked for the velocity: it uses the pose's";
+  }
+  if (2 * refused > k) {
+    notes += std::string(notes.empty() ? "" : "; ") + std::to_string(refused) + " of " +
+             std::to_string(k) + " bandwidths were refused (the first: " +
+             *std::find_if(selection.refusals.begin(), selection.refusals.end(),
+                           [](const std::string& r) { return !r.empty(); }) +
+             ")";
+  }
+  selection.message = notes;
+  return selection;
+}
+
+// `count` bandwidths, geometrically spaced from `smallest_spacings` median
+// sample spacings up to the covariates' whole range. Empty when the
+// covariates have fewer than two distinct values.
+template <class Covariates>
+std::vector<double> bandwidth_grid(const Covariates& covariates, int count = 20,
+                                   double smallest_spacings = 2) {
+  std::vector<double> t(covariates.begin(), covariates.end());
+  std::sort(t.begin(), t.end());
+  std::vector<double> spacings;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) spacings.push_back(t[i] - t[i - 1]);
+  }
+  if (spacings.empty() || count < 2) return {};
+  const auto middle = spacings.begin() + static_cast<std::ptrdiff_t>(spacings.size() / 2);
+  std::nth_element(spacings.begin(), middle, spacings.end());
+  const double low = smallest_spacings * *middle;
+  const double high = t.back() - t.front();
+  if (!(high > low)) return {high};
+  std::vector<double> grid(static_cast<std::size_t>(count));
+  const double ratio = std::log(high / low) / (count - 1);
+  for (int k = 0; k < count; ++k)
+    grid[static_cast<std::size_t>(k)] = low * std::exp(ratio * k);
+  return grid;
+}
+
+}  // namespace bireg
