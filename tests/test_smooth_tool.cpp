@@ -16,6 +16,7 @@
 
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/version.hpp"
 #include "catch.hpp"
 #include "tool_runner.hpp"
 
@@ -53,15 +54,27 @@ std::vector<std::string> split(const std::string& text, char separator) {
 struct Line {
   std::string time;
   std::vector<double> numbers;
+  std::string status;  // the velocity CSV's last column: "ok" or "failed: ..."
 };
 
 std::vector<Line> parse_csv(const std::string& text) {
   std::vector<Line> lines;
   for (const std::string& row : split(text, '\n')) {
     if (row.empty()) continue;
-    const std::vector<std::string> fields = split(row, ',');
+    std::vector<std::string> fields = split(row, ',');
     Line line;
     line.time = fields[0];
+    // The velocity CSV's status: "ok", or "failed: ..." (quoted when its
+    // reason holds a comma, which then spans several fields).
+    for (std::size_t k = 1; k < fields.size(); ++k) {
+      if (fields[k] == "ok" || fields[k].rfind("failed", 0) == 0 ||
+          fields[k].rfind("\"failed", 0) == 0) {
+        for (std::size_t j = k; j < fields.size(); ++j)
+          line.status += (j == k ? "" : ",") + fields[j];
+        fields.resize(k);
+        break;
+      }
+    }
     // An empty field (an undefined standard error) reads as NaN.
     for (std::size_t k = 1; k < fields.size(); ++k) {
       line.numbers.push_back(fields[k].empty() ? std::nan("")
@@ -155,9 +168,6 @@ TEST_CASE("bireg_smooth: every hostile input gives exit 2 and one line naming fi
        "wrong_columns.tum:2: expected 8 numbers"},
       {"--bandwidth 1 - < " + make_file("stdin_text.csv", "0, 1, 0, 0, 0, 1, 0, 0, 0, 1\nx\n"),
        "<stdin>:2: "},
-      // so3_small.csv's timestamps are 2 + k 3/11: a bandwidth of 0.01 s
-      // leaves every window with one observation, the first at line 3.
-      {"--bandwidth 0.01 " + small, "so3_small.csv:3: fewer than two distinct covariates"},
       {"--bandwidth 1 --at " + make_file("at_text.txt", "2.5\nabc\n") + " " + small,
        "at_text.txt:2: not a number: 'abc'"},
       {"--bandwidth 1 --at " + make_file("at_two.txt", "# t\n2.5 3\n") + " " + small,
@@ -232,7 +242,7 @@ TEST_CASE("bireg_smooth: a noise-free SO3 geodesic is smoothed to its poses and 
     const std::vector<Line> input_lines = parse_csv(file.text);
     REQUIRE(poses.size() == input_lines.size());
     const std::vector<std::string> csv = split(slurp(velocity), '\n');
-    REQUIRE(csv.at(0) == "t,wx,wy,wz,se_wx,se_wy,se_wz");
+    REQUIRE(csv.at(0) == "t,wx,wy,wz,se_wx,se_wy,se_wz,status");
     const std::vector<Line> velocities = parse_csv(slurp(velocity).substr(csv.at(0).size() + 1));
     REQUIRE(velocities.size() == poses.size());
     for (std::size_t k = 0; k < poses.size(); ++k) {
@@ -242,6 +252,7 @@ TEST_CASE("bireg_smooth: a noise-free SO3 geodesic is smoothed to its poses and 
       const double t = static_cast<double>(k) / 10.0;
       REQUIRE((element_of<G>(poses[k].numbers) - file.at(t)).norm() < 1e-10);
       REQUIRE(velocities[k].numbers.size() == 6);
+      REQUIRE(velocities[k].status == "ok");
       for (int i = 0; i < 3; ++i) {
         REQUIRE(std::abs(velocities[k].numbers[static_cast<std::size_t>(i)] - file.velocity[i]) <
                 1e-10);
@@ -268,7 +279,7 @@ TEST_CASE("bireg_smooth: SE3 velocity columns are translation first, as the grou
   REQUIRE(run.exit_code == 0);
   const std::string text = slurp(csv);
   const std::string header = split(text, '\n').at(0);
-  REQUIRE(header == "t,vx,vy,vz,wx,wy,wz,se_vx,se_vy,se_vz,se_wx,se_wy,se_wz");
+  REQUIRE(header == "t,vx,vy,vz,wx,wy,wz,se_vx,se_vy,se_vz,se_wx,se_wy,se_wz,status");
   const std::vector<Line> rows = parse_csv(text.substr(header.size() + 1));
   REQUIRE(rows.size() == 40);
   const std::vector<Line> poses = parse_csv(run.out);
@@ -360,7 +371,13 @@ TEST_CASE("bireg_smooth: --bandwidth auto chooses a bandwidth, says so, and smoo
   CAPTURE(run.err);
   REQUIRE(run.exit_code == 0);
   REQUIRE(run.err.rfind("bireg_smooth: bandwidth auto: ", 0) == 0);
-  REQUIRE(run.err.find('\n') == run.err.size() - 1);
+  // The choice, and at most a warning line (a noise-free geodesic is best
+  // fitted at the grid's smallest bandwidth, which the warning says).
+  const std::vector<std::string> err_lines = split(run.err, '\n');
+  for (std::size_t k = 1; k < err_lines.size(); ++k) {
+    if (!err_lines[k].empty())
+      REQUIRE(err_lines[k].rfind("bireg_smooth: warning: bandwidth auto: ", 0) == 0);
+  }
   // A noise-free geodesic is recovered at any bandwidth: whichever was chosen.
   const std::vector<Line> poses = parse_csv(run.out);
   REQUIRE(poses.size() == 40);
@@ -404,4 +421,93 @@ TEST_CASE("bireg_smooth: the output does not depend on --threads", "[tool]") {
   }
   REQUIRE(outputs[1] == outputs[0]);
   REQUIRE(outputs[2] == outputs[0]);
+}
+
+TEST_CASE("bireg_smooth: --help and --version answer on stdout with exit 0", "[tool]") {
+  const Run help = run_tool("--help");
+  REQUIRE(help.exit_code == 0);
+  REQUIRE(help.err.empty());
+  for (const char* option : {"--group", "--format", "--times", "--project", "--bandwidth",
+                             "--kernel", "--at", "--rate", "--velocity", "--cv-table", "--output",
+                             "--output-format", "--threads", "--progress", "--version"}) {
+    CAPTURE(option);
+    REQUIRE(help.out.find(option) != std::string::npos);
+  }
+  REQUIRE(help.out.find("Exit codes") != std::string::npos);
+  const Run version = run_tool("--version");
+  REQUIRE(version.exit_code == 0);
+  REQUIRE(version.out == std::string("bireg_smooth ") + bireg::version + "\n");
+}
+
+// A planted failing region: a geodesic sampled at 100.0 .. 101.9 and
+// 104.0 .. 105.9 s, smoothed with a Gaussian of 0.04 s (support 0.16 s)
+// at --rate 10: the queries from 102.0 to 103.9 s have at most one
+// observation in their window. Each of those rows fails, says why, and has no numbers;
+// its pose is left out; the exit code is 3; the rows around it are ok.
+TEST_CASE("bireg_smooth: failed rows carry a status, no numbers, and exit 3", "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.4, -0.2, 0.3), 60);
+  std::string text;
+  int k = 0;
+  for (const std::string& line : split(file.text, '\n')) {
+    if (!line.empty() && (k < 20 || k >= 40)) text += line + '\n';
+    ++k;
+  }
+  const std::string input = make_file("so3_gap.csv", text);
+  const fs::path velocity = work_dir() / "so3_gap_velocity.csv";
+  const Run run = run_tool("--group SO3 --bandwidth 0.04 --rate 10 --velocity \"" +
+                           velocity.string() + "\" " + input);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 3);
+  REQUIRE(run.err.find("failed (pose): fewer than two distinct covariates") != std::string::npos);
+  const std::vector<Line> rows = parse_csv(slurp(velocity).substr(slurp(velocity).find('\n') + 1));
+  REQUIRE(rows.size() == 60);
+  std::size_t failed = 0;
+  for (const Line& row : rows) {
+    const double t = std::strtod(row.time.c_str(), nullptr);
+    CAPTURE(row.time, row.status);
+    const bool in_gap = t > 101.95 && t < 103.95;
+    if (in_gap) {
+      ++failed;
+      // "failed: <reason>", in quotes when the reason holds a comma.
+      REQUIRE((row.status.rfind("failed: ", 0) == 0 || row.status.rfind("\"failed: ", 0) == 0));
+      for (const double x : row.numbers)
+        REQUIRE(std::isnan(x));  // empty fields
+    } else {
+      REQUIRE(row.status == "ok");
+      for (int i = 0; i < 3; ++i)
+        REQUIRE(std::abs(row.numbers[static_cast<std::size_t>(i)] - file.velocity[i]) < 1e-9);
+    }
+  }
+  REQUIRE(failed == 20);
+  REQUIRE(parse_csv(run.out).size() == 60 - failed);
+}
+
+TEST_CASE("bireg_smooth: --cv-table writes both cross-validation curves", "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.4, -0.2, 0.3), 40);
+  const fs::path table = work_dir() / "cv_table.csv";
+  const Run run = run_tool("--group SO3 --cv-table \"" + table.string() + "\" " +
+                           make_file("so3_geodesic_cv.csv", file.text));
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::vector<std::string> lines = split(slurp(table), '\n');
+  REQUIRE(lines.at(0) ==
+          "bandwidth,criterion,failures,refused,velocity_criterion,velocity_failures,"
+          "velocity_refused");
+  std::size_t rows = 0;
+  double previous = 0;
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    if (lines[k].empty()) continue;
+    ++rows;
+    const double bandwidth = std::strtod(lines[k].c_str(), nullptr);
+    REQUIRE(bandwidth > previous);  // ascending
+    previous = bandwidth;
+  }
+  REQUIRE(rows == 20);
+  // From half the spacing (0.1 s) to the whole range (3.9 s).
+  REQUIRE(std::abs(std::strtod(lines[1].c_str(), nullptr) - 0.05) < 1e-12);
+  REQUIRE(std::abs(previous - 3.9) < 1e-9);
 }

@@ -4,17 +4,25 @@
 //   bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]
 //                [--times FILE] [--project]
 //                [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]
-//                [--at FILE | --rate HZ] [--velocity FILE]
+//                [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]
 //                [--output FILE] [--output-format matrix|tum|euroc|kitti]
-//                [--threads N] FILE|-
+//                [--threads N] [--progress] FILE|-
+//   bireg_smooth --help | --version
 //
 // Input as bireg_fit (same formats, detection, --times and --project).
 // H is in seconds (frames for KITTI without --times); the kernels and the
-// Gaussian's truncation at 4 H are those of the library. "auto" (the
-// default) chooses H by leave-one-out cross-validation (select_bandwidth)
-// over 20 values from 2 median sample spacings to the whole range, and
-// prints the choice as one line on stderr; it costs 20 smoothing passes,
-// the widest windows O(N^2) each (give H for long recordings).
+// Gaussian's truncation at 4 H are those of the library, and so is the cut
+// of every window where it would turn by more than 2.5 rad
+// (LocalRegressionOptions::max_turn). "auto" (the default) chooses two
+// bandwidths by cross-validation (select_bandwidth) over 20 values from
+// half a median sample spacing to the whole range: the poses' by
+// leave-one-out prediction, the velocity's against held-out chords, and
+// prints both as one line on stderr, and a warning line when a choice is at
+// the grid's edge or most values were refused; --cv-table FILE writes the
+// curves (CSV: bandwidth, criterion, failures, refused, and the same for
+// the velocity). It costs 40 smoothing passes, each window capped in turn
+// and in the kernel's support; --progress (or a terminal on stderr) shows
+// how far it is after two seconds.
 //
 // Where the trajectory is evaluated:
 //   default    at every input line's timestamp, in input order, each output
@@ -36,19 +44,23 @@
 // queries; the output does not depend on N.
 //
 // Output: the smoothed poses in the input's format (or --output-format), to
-// stdout or --output. --velocity FILE writes CSV: a header line
-// "t,<coordinates>,<their standard errors>", the body velocity's tangent
-// coordinates in the group's order per second (SO2: w; SO3: wx,wy,wz in
-// rad/s; SE2: vx,vy,w; SE3: vx,vy,vz,wx,wy,wz, translation first as in
-// bireg/groups/se3.hpp), then se_<name> for each; t is the output's
+// stdout or --output, one per query whose local fit succeeded. --velocity
+// FILE writes CSV: a header line "t,<coordinates>,<their standard
+// errors>,status", the body velocity's tangent coordinates in the group's
+// order per second (SO2: w; SO3: wx,wy,wz in rad/s; SE2: vx,vy,w; SE3:
+// vx,vy,vz,wx,wy,wz, translation first as in bireg/groups/se3.hpp), then
+// se_<name> for each, then "ok" or "failed: <reason>"; t is the output's
 // timestamp text. A standard error that is not defined (a window of two
-// observations, or residuals that are all zero) is an empty field.
+// observations, or residuals that are all zero) is an empty field, and so
+// is every number of a failed row.
 //
-// Exit codes as bireg_fit: 0 every local fit converged, 2 invalid input or
-// usage (one line on stderr naming file, line and problem; also a query
-// whose kernel window holds fewer than two distinct timestamps: widen H),
-// 3 some local fit did not converge (output still written, its last
-// iterate; one line per such query on stderr), 4 output could not be written.
+// Exit codes as bireg_fit: 0 every query ok, 2 invalid input or usage (one
+// line on stderr naming file, line and problem), 3 some queries failed
+// (a window with fewer than two distinct timestamps, or a local fit that
+// failed at every width: each named on stderr, the first ten, their poses
+// left out -- with KITTI output, which has no timestamps, no poses are
+// written -- and their velocity rows marked failed), 4 output could not be
+// written. --help and --version print to stdout and exit 0.
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -63,6 +75,7 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
 
@@ -77,12 +90,49 @@ constexpr const char* kUsage =
     "usage: bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]\n"
     "                    [--times FILE] [--project]\n"
     "                    [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]\n"
-    "                    [--at FILE | --rate HZ] [--velocity FILE]\n"
+    "                    [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]\n"
     "                    [--output FILE] [--output-format matrix|tum|euroc|kitti]\n"
-    "                    [--threads N] FILE|-\n";
+    "                    [--threads N] [--progress] FILE|-\n"
+    "       bireg_smooth --help | --version\n";
 
-// Bandwidths tried by --bandwidth auto.
+constexpr const char* kHelp =
+    "Pose and body velocity along a trajectory by kernel-weighted local geodesic\n"
+    "regression (bireg/statistics/local_regression.hpp).\n"
+    "\n"
+    "  --group G          SO2, SO3, SE2 or SE3 (required)\n"
+    "  --format F         input format: matrix, tum, euroc or kitti (default: detected)\n"
+    "  --times FILE       timestamps for a KITTI file, one per line\n"
+    "  --project          project near-elements onto the group instead of refusing them\n"
+    "  --bandwidth H|auto kernel bandwidth in seconds (frames for KITTI without --times);\n"
+    "                     auto (default): cross-validation over 20 values from half a\n"
+    "                     median sample spacing to the whole range, one choice for the\n"
+    "                     poses and one for the velocity, printed on stderr\n"
+    "  --kernel K         gaussian (default; truncated at 4 H), epanechnikov or tricube\n"
+    "  --at FILE          evaluate at the timestamps in FILE (one per line) instead of\n"
+    "                     at every input timestamp\n"
+    "  --rate HZ          evaluate at first + k / HZ up to the last timestamp\n"
+    "  --velocity FILE    write the body velocity (rad/s; m/s for translations) with\n"
+    "                     its standard errors and a status per row, as CSV\n"
+    "  --cv-table FILE    write the cross-validation curves of --bandwidth auto as CSV\n"
+    "  --output FILE      the smoothed poses (default: standard output)\n"
+    "  --output-format F  their format (default: the input's)\n"
+    "  --threads N        threads, 1 to 1024 (default: every core); the output does not\n"
+    "                     depend on N\n"
+    "  --progress         progress on stderr for long work (default: only when stderr\n"
+    "                     is a terminal), never on stdout\n"
+    "  --help, --version  this text; the version\n"
+    "\n"
+    "Exit codes: 0 every row ok; 2 invalid input or usage (one line naming\n"
+    "file:line); 3 some rows failed (stderr names them; a failed pose is left out\n"
+    "of the pose output, or with KITTI output no poses are written; a failed\n"
+    "velocity row says 'failed: <reason>'); 4 output could not be written.\n";
+
+// Bandwidths tried by --bandwidth auto: kAutoGridSize values from
+// kAutoSmallestSpacings median sample spacings to the whole range. Half a
+// spacing is the narrowest useful Gaussian (its window then holds a sample
+// on each side); noise-free or fast recordings need it.
 constexpr int kAutoGridSize = 20;
+constexpr double kAutoSmallestSpacings = 0.5;
 
 // More queries than this from --rate is a typing error, not a request.
 constexpr double kMaxRateQueries = 1e8;
@@ -95,6 +145,10 @@ struct Command {
   std::string at;
   std::optional<double> rate;
   std::string velocity;
+  std::string cv_table;
+  bool progress = false;
+  bool help = false;
+  bool version = false;
   std::string output = "-";
   std::optional<bireg::io::Format> output_format;  // empty: the input's
   int threads = bireg_cli::default_threads();
@@ -117,6 +171,18 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     if (arg == "--project") {
       command.input.project = true;
       continue;
+    }
+    if (arg == "--progress") {
+      command.progress = true;
+      continue;
+    }
+    if (arg == "--help" || arg == "-h") {
+      command.help = true;
+      return std::nullopt;
+    }
+    if (arg == "--version") {
+      command.version = true;
+      return std::nullopt;
     }
     if (i + 1 >= argc) return "option " + arg + " needs a value";
     const std::string v = argv[++i];
@@ -156,6 +222,8 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       command.rate = hz;
     } else if (arg == "--velocity") {
       command.velocity = v;
+    } else if (arg == "--cv-table") {
+      command.cv_table = v;
     } else if (arg == "--output") {
       command.output = v;
     } else if (arg == "--threads") {
@@ -207,7 +275,15 @@ bireg::io::Timestamp rate_timestamp(const bireg::io::Timestamp& origin, std::uin
   return t;
 }
 
-// Writes the velocity CSV; returns "path: reason" when it cannot.
+// Why a query failed, in one line.
+template <class G>
+std::string failure_reason(const bireg::LocalEstimate<G>& e) {
+  return e.message.empty() ? std::string(bireg::to_string(e.status)) : e.message;
+}
+
+// Writes the velocity CSV (header t, the tangent coordinates, se_ of each,
+// status); a failed row has empty numbers and "failed: <reason>".
+// Returns "path: reason" when it cannot be written.
 template <class G>
 std::optional<std::string> write_velocity(const std::string& path,
                                           const std::vector<bireg::io::Timestamp>& times,
@@ -218,30 +294,54 @@ std::optional<std::string> write_velocity(const std::string& path,
     text += "," + name;
   for (const std::string& name : names)
     text += ",se_" + name;
-  text += '\n';
+  text += ",status\n";
   for (std::size_t q = 0; q < estimates.size(); ++q) {
     const bireg::LocalEstimate<G>& e = estimates[q];
     text += times[q].text;
+    const bool ok = e.ok();
     for (int k = 0; k < e.velocity.size(); ++k) {
       text += ',';
-      bireg::io::append_double(text, e.velocity[k]);
+      if (ok) bireg::io::append_double(text, e.velocity[k]);
     }
     for (int k = 0; k < e.velocity.size(); ++k) {
       text += ',';
-      if (e.velocity_error_defined) bireg::io::append_double(text, e.velocity_error[k]);
+      if (ok && e.velocity_error_defined) bireg::io::append_double(text, e.velocity_error[k]);
     }
+    text += ',';
+    text += ok ? std::string("ok") : bireg_cli::csv_field("failed: " + failure_reason(e));
     text += '\n';
   }
-  std::FILE* out = std::fopen(path.c_str(), "wb");
-  if (!out) return path + ": cannot write file (" + std::strerror(errno) + ")";
-  errno = 0;
-  const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
-  const bool closed = std::fclose(out) == 0;
-  if (!written || !closed) {
-    return path + ": write error: " + (errno != 0 ? std::strerror(errno) : "unknown");
-  }
-  return std::nullopt;
+  return bireg_cli::write_text_file(path, text);
 }
+
+// The cross-validation curves of --bandwidth auto, one row per bandwidth:
+// its criteria (empty where refused), failed held-out fits, and why a
+// value was refused.
+template <class Scalar>
+std::optional<std::string> write_cv_table(const std::string& path,
+                                          const bireg::BandwidthSelection<Scalar>& selection) {
+  namespace io = bireg::io;
+  std::string text =
+      "bandwidth,criterion,failures,refused,velocity_criterion,velocity_failures,"
+      "velocity_refused\n";
+  const auto number = [&](Scalar x) {
+    if (std::isfinite(x)) io::append_double(text, x);
+  };
+  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
+    number(selection.grid[k]);
+    text += ',';
+    number(selection.criterion[k]);
+    text += ',' + std::to_string(selection.failures[k]) + ',' +
+            bireg_cli::csv_field(selection.refusals[k]) + ',';
+    number(selection.velocity_criterion[k]);
+    text += ',' + std::to_string(selection.velocity_failures[k]) + ',' +
+            bireg_cli::csv_field(selection.velocity_refusals[k]) + '\n';
+  }
+  return bireg_cli::write_text_file(path, text);
+}
+
+// One line on stderr per failed query, the first kFailuresShown of them.
+constexpr std::size_t kFailuresShown = 10;
 
 template <class G>
 int run(const Command& command) {
@@ -307,59 +407,102 @@ int run(const Command& command) {
   bireg::LocalRegressionOptions<double> options;
   options.kernel = command.kernel;
   options.threads = command.threads;
+  double velocity_bandwidth = 0;
   if (command.bandwidth) {
     options.bandwidth = *command.bandwidth;
+    velocity_bandwidth = options.bandwidth;
   } else {
-    const std::vector<double> grid = bireg::bandwidth_grid(trajectory.covariates, kAutoGridSize);
+    const std::vector<double> grid =
+        bireg::bandwidth_grid(trajectory.covariates, kAutoGridSize, kAutoSmallestSpacings);
+    bireg_cli::Progress progress("bireg_smooth", command.progress);
     const bireg::BandwidthSelection<double> selection =
-        bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid);
+        bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid,
+                                   [&](std::size_t done, std::size_t total) {
+                                     progress.update("bandwidth auto", done, total);
+                                   });
+    progress.finish();
+    if (!command.cv_table.empty()) {
+      if (auto error = write_cv_table(command.cv_table, selection)) {
+        std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
+        return kExitWriteError;
+      }
+    }
     if (!selection.ok()) {
-      return fail(name + ": no bandwidth from " + io::json_number(grid.front()) + " to " +
-                  io::json_number(grid.back()) +
-                  " s fits every leave-one-out window (the narrowest: " +
-                  selection.problems.front() + "): give --bandwidth H");
+      return fail(name + ": bandwidth auto: " + selection.message + ": give --bandwidth H");
     }
     options.bandwidth = selection.bandwidth;
+    velocity_bandwidth = selection.velocity_bandwidth;
     std::fprintf(stderr,
-                 "bireg_smooth: bandwidth auto: %s s (leave-one-out cross-validation over %zu "
-                 "values from %s to %s s)\n",
-                 io::json_number(selection.bandwidth).c_str(), grid.size(),
+                 "bireg_smooth: bandwidth auto: %s s for the poses, %s s for the velocity "
+                 "(cross-validation over %zu values from %s to %s s)\n",
+                 io::json_number(selection.bandwidth).c_str(),
+                 io::json_number(selection.velocity_bandwidth).c_str(), grid.size(),
                  io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
+    if (!selection.message.empty()) {
+      std::fprintf(stderr, "bireg_smooth: warning: bandwidth auto: %s\n",
+                   selection.message.c_str());
+    }
   }
-  const bireg::LocalGeodesicRegression<G> smoother(options);
   const std::vector<bireg::LocalEstimate<G>> estimates =
-      smoother.smooth_at(trajectory.observations, trajectory.covariates, queries);
+      bireg::LocalGeodesicRegression<G>(options).smooth_at(trajectory.observations,
+                                                           trajectory.covariates, queries);
+  std::vector<bireg::LocalEstimate<G>> velocity_estimates;
+  if (!command.velocity.empty() && velocity_bandwidth != options.bandwidth) {
+    bireg::LocalRegressionOptions<double> velocity_options = options;
+    velocity_options.bandwidth = velocity_bandwidth;
+    velocity_estimates = bireg::LocalGeodesicRegression<G>(velocity_options)
+                             .smooth_at(trajectory.observations, trajectory.covariates, queries);
+  }
+  const std::vector<bireg::LocalEstimate<G>>& velocities =
+      velocity_estimates.empty() ? estimates : velocity_estimates;
 
-  bool all_converged = true;
+  // Failed rows: the query is named on stderr (the first few), its pose is
+  // left out of the pose output and its velocity row says why.
+  std::size_t failed = 0;
+  std::vector<io::Timestamp> pose_times;
   std::vector<typename G::Element> poses;
   poses.reserve(estimates.size());
   for (std::size_t q = 0; q < estimates.size(); ++q) {
-    const bireg::LocalEstimate<G>& e = estimates[q];
-    if (e.status == bireg::Status::invalid_input) {
-      return fail(query_places[q] + ": " + e.message);
+    const bireg::LocalEstimate<G>& pose = estimates[q];
+    const bireg::LocalEstimate<G>& velocity = velocities[q];
+    const bireg::LocalEstimate<G>& bad = pose.ok() ? velocity : pose;
+    if (!bad.ok()) {
+      if (failed++ < kFailuresShown) {
+        std::fprintf(stderr, "bireg_smooth: %s: failed (%s): %s\n", query_places[q].c_str(),
+                     &bad == &pose ? "pose" : "velocity", failure_reason(bad).c_str());
+      }
     }
-    if (!e.ok()) {
-      all_converged = false;
-      const std::string why = e.message.empty() ? std::string() : ": " + e.message;
-      std::fprintf(stderr, "bireg_smooth: %s: the local fit ended %s%s\n", query_places[q].c_str(),
-                   bireg::to_string(e.status), why.c_str());
-    }
-    poses.push_back(e.pose);
+    if (!pose.ok()) continue;
+    poses.push_back(pose.pose);
+    pose_times.push_back(query_times[q]);
+  }
+  if (failed > kFailuresShown) {
+    std::fprintf(stderr,
+                 "bireg_smooth: %zu queries failed in all (%zu named above; the status column "
+                 "of --velocity names each)\n",
+                 failed, kFailuresShown);
   }
 
   const io::Format format = command.output_format.value_or(trajectory.format);
-  if (auto error = bireg_cli::write_output<G>(command.output, format, trajectory.format,
-                                              query_times, poses)) {
+  // KITTI lines carry no timestamp: a reader counts them as frames, so a
+  // pose left out would shift every later one. No pose output then.
+  if (format == io::Format::kitti && poses.size() < estimates.size()) {
+    std::fprintf(stderr,
+                 "bireg_smooth: no pose output: KITTI lines have no timestamps, so the %zu "
+                 "failed queries cannot be left out (use --output-format tum or matrix)\n",
+                 estimates.size() - poses.size());
+  } else if (auto error = bireg_cli::write_output<G>(command.output, format, trajectory.format,
+                                                     pose_times, poses)) {
     std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
     return kExitWriteError;
   }
   if (!command.velocity.empty()) {
-    if (auto error = write_velocity<G>(command.velocity, query_times, estimates)) {
+    if (auto error = write_velocity<G>(command.velocity, query_times, velocities)) {
       std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
       return kExitWriteError;
     }
   }
-  return all_converged ? 0 : kExitNotConverged;
+  return failed == 0 ? 0 : kExitNotConverged;
 }
 
 }  // namespace
@@ -369,6 +512,14 @@ int bireg_cli::smooth_main(int argc, char** argv) {
   if (const auto error = parse_command(argc, argv, command)) {
     std::fprintf(stderr, "bireg_smooth: %s\n%s", error->c_str(), kUsage);
     return kExitInvalid;
+  }
+  if (command.help) {
+    std::printf("%s\n%s", kUsage, kHelp);
+    return 0;
+  }
+  if (command.version) {
+    std::printf("bireg_smooth %s\n", bireg::version);
+    return 0;
   }
   if (command.group == "SO2") return run<bireg::SO2<double>>(command);
   if (command.group == "SO3") return run<bireg::SO3<double>>(command);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -18,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include <unistd.h>
+
 #include "bireg/io/formats.hpp"
 #include "bireg/io/line_reader.hpp"
 #include "bireg/io/writers.hpp"
@@ -25,7 +28,7 @@
 namespace bireg_cli {
 
 constexpr int kExitInvalid = 2;       // invalid input or usage
-constexpr int kExitNotConverged = 3;  // a fit did not converge (output still written)
+constexpr int kExitNotConverged = 3;  // a fit, or some rows, failed (output still written)
 constexpr int kExitWriteError = 4;    // output could not be written
 
 // A finite number spelt entirely by `text` (strtod's syntax).
@@ -249,5 +252,76 @@ inline std::optional<std::string> read_query_times(const std::string& path,
   if (!error && times.empty()) error = name + ": no timestamps";
   return error;
 }
+
+// Writes `text` to the file `path`; returns "path: reason" when it cannot.
+inline std::optional<std::string> write_text_file(const std::string& path,
+                                                  const std::string& text) {
+  std::FILE* out = std::fopen(path.c_str(), "wb");
+  if (!out) return path + ": cannot write file (" + std::strerror(errno) + ")";
+  errno = 0;
+  const bool written = std::fwrite(text.data(), 1, text.size(), out) == text.size();
+  const bool closed = std::fclose(out) == 0;
+  if (!written || !closed) {
+    return path + ": write error: " + (errno != 0 ? std::strerror(errno) : "unknown");
+  }
+  return std::nullopt;
+}
+
+// A CSV field: as it is, or in double quotes (inner quotes doubled) when it
+// holds a comma, a quote or a line break.
+inline std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c == '\n' || c == '\r' ? ' ' : c;
+  }
+  return quoted + "\"";
+}
+
+// Progress of long work on stderr, never on stdout: shown when asked
+// (--progress) or when stderr is a terminal, and only once the work has run
+// for two seconds (short runs stay quiet). On a terminal one line is
+// rewritten in place; otherwise a line is written at every tenth.
+class Progress {
+ public:
+  Progress(const char* tool, bool requested)
+      : tool_(tool),
+        terminal_(isatty(STDERR_FILENO) != 0),
+        enabled_(requested || terminal_),
+        start_(std::chrono::steady_clock::now()) {}
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  ~Progress() { finish(); }
+
+  // `done` of `total` units of `what` are finished.
+  void update(const char* what, std::size_t done, std::size_t total) {
+    if (!enabled_ || total == 0) return;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (seconds < 2.0) return;
+    const int percent = static_cast<int>(100.0 * static_cast<double>(done) / total);
+    if (!terminal_ && percent / 10 == last_tenth_) return;
+    last_tenth_ = percent / 10;
+    std::fprintf(stderr, "%s%s: %s: %d%% (%zu of %zu) after %.1f s%s", terminal_ ? "\r" : "", tool_,
+                 what, percent, done, total, seconds, terminal_ ? "\033[K" : "\n");
+    std::fflush(stderr);
+    shown_ = true;
+  }
+
+  // Ends the in-place line, so what follows starts on a line of its own.
+  void finish() {
+    if (shown_ && terminal_) std::fputc('\n', stderr);
+    shown_ = false;
+  }
+
+ private:
+  const char* tool_;
+  bool terminal_;
+  bool enabled_;
+  std::chrono::steady_clock::time_point start_;
+  int last_tenth_ = -1;
+  bool shown_ = false;
+};
 
 }  // namespace bireg_cli
