@@ -15,13 +15,19 @@
 // 0.02 rad per axis added to every sample (R_i exp(e_i), seed 20261123):
 //   finite differences: central, w_i = log(R_{i-1}^T R_{i+1}) / (t_{i+1} - t_{i-1})
 //     (one-sided at the two ends);
-//   bireg: LocalGeodesicRegression<SO3>, Gaussian kernel, bandwidth chosen
-//     by select_bandwidth (leave-one-out) over 12 values from 1 sample
-//     spacing (the Gaussian's window then holds 9 samples) to 0.25 s (wider
-//     windows turn through more than pi on this recording).
+//   the chart line: a Gaussian-weighted line through log(R_c^T R_j) at each
+//     sample c, at the bandwidth that is best against the gyroscope (which
+//     no smoother can see; bireg/testing/fast_motion.hpp);
+//   bireg: LocalGeodesicRegression<SO3>, Gaussian kernel, what
+//     `bireg_smooth --bandwidth auto` does: select_bandwidth over 20 values
+//     from half a median sample spacing to the whole range, the velocity
+//     smoothed at the velocity's choice.
 // Prints the RMS error |w - w_gyro| over all samples (rad/s) and the chosen
-// bandwidths; draws `gyro_demo.svg` (or argv[1]): seconds 20 to 22 with the
-// gyroscope, finite differences and bireg at 0.02 rad.
+// bandwidths: for the 128 Hz recording, for it subsampled to 50 and 25 Hz
+// (fast relative to the sampling: up to 0.2 and 0.4 rad between samples),
+// and for simulated spins and a whip whose truth is known exactly. Draws
+// `gyro_demo.svg` (or argv[1]): seconds 20 to 22 of the 128 Hz recording
+// with the gyroscope, finite differences and bireg at 0.02 rad.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -34,6 +40,7 @@
 
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "bireg/testing/fast_motion.hpp"
 #include "svg_plot.hpp"
 
 namespace {
@@ -87,28 +94,13 @@ Vector3 gyro_at(const Columns& gyro, double t) {
   return (1 - share) * row(j - 1) + share * row(j);
 }
 
-std::vector<Vector3> finite_differences(const std::vector<SO3::Element>& r,
-                                        const std::vector<double>& t) {
-  const std::size_t n = r.size();
-  std::vector<Vector3> w(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t before = i == 0 ? 0 : i - 1;
-    const std::size_t after = i + 1 == n ? n - 1 : i + 1;
-    w[i] = SO3::log(SO3::compose(SO3::inverse(r[before]), r[after])) / (t[after] - t[before]);
-  }
-  return w;
-}
-
-double rms_error(const std::vector<Vector3>& w, const std::vector<Vector3>& reference) {
-  double sum = 0;
-  for (std::size_t i = 0; i < w.size(); ++i)
-    sum += (w[i] - reference[i]).squaredNorm();
-  return std::sqrt(sum / static_cast<double>(w.size()));
-}
+using bireg::testing::finite_differences;
+using bireg::testing::rms_error;
 
 struct Smoothed {
   std::vector<Vector3> velocity;
-  double bandwidth = 0;
+  double bandwidth = 0;       // the velocity's
+  double pose_bandwidth = 0;  // the pose's
   int failed = 0;
   double mean_iterations = 0;
 };
@@ -117,18 +109,14 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   bireg::LocalRegressionOptions<double> options;
   options.kernel = bireg::Kernel::gaussian;
   options.standard_errors = false;
-  const double spacing = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  const int grid_size = 12;
-  const double smallest = spacing, largest = 0.25;
-  std::vector<double> grid;
-  for (int k = 0; k < grid_size; ++k)
-    grid.push_back(smallest * std::pow(largest / smallest, k / double(grid_size - 1)));
+  const std::vector<double> grid = bireg::bandwidth_grid(t, 20, 0.5);
   const bireg::BandwidthSelection<double> selection =
       bireg::select_bandwidth<SO3>(r, t, options, grid);
   Smoothed out;
-  out.bandwidth = selection.bandwidth;
+  out.bandwidth = selection.velocity_bandwidth;
+  out.pose_bandwidth = selection.bandwidth;
   if (!selection.ok()) return out;
-  options.bandwidth = selection.bandwidth;
+  options.bandwidth = selection.velocity_bandwidth;
   const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(r, t);
   long iterations = 0;
   for (const auto& e : estimates) {
@@ -181,6 +169,38 @@ bool write_plot_svg(const std::string& path, double from, double to, double nois
   return static_cast<bool>(out);
 }
 
+// One row of the table: the three estimators' RMS errors against `truth`
+// and bireg's bandwidths. Returns bireg's velocities (empty on failure).
+std::vector<Vector3> print_row(const std::string& label, double noise,
+                               const std::vector<SO3::Element>& r, const std::vector<double>& t,
+                               const std::vector<Vector3>& truth) {
+  const std::vector<Vector3> differences = finite_differences(r, t);
+  const auto [chart, chart_bandwidth] = bireg::testing::oracle_chart_line(r, t, truth);
+  const Smoothed smoothed = smooth(r, t);
+  if (smoothed.velocity.empty() || smoothed.failed > 0) {
+    std::fprintf(stderr, "gyro_demo: %s, noise %g: the local regression failed (%d queries)\n",
+                 label.c_str(), noise, smoothed.failed);
+    return {};
+  }
+  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f | %.2f |\n", label.c_str(), noise,
+              rms_error(differences, truth), chart, chart_bandwidth,
+              rms_error(smoothed.velocity, truth), smoothed.pose_bandwidth, smoothed.bandwidth,
+              smoothed.mean_iterations);
+  return smoothed.velocity;
+}
+
+// The indices of the first sample at or after each k / hz.
+std::vector<std::size_t> subsample(const std::vector<double>& t, double hz) {
+  std::vector<std::size_t> kept;
+  double next = t.front();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < next - 1e-9) continue;
+    kept.push_back(i);
+    next += 1.0 / hz;
+  }
+  return kept;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -188,48 +208,70 @@ int main(int argc, char** argv) {
   Columns orientation, gyroscope;
   if (!read_csv(dir + "/xio_imu_orientation.csv", 9, orientation)) return 1;
   if (!read_csv(dir + "/xio_imu_gyroscope.csv", 3, gyroscope)) return 1;
-  const std::vector<double>& t = orientation.t;
   std::vector<SO3::Element> raw;
   std::vector<Vector3> reference;
-  for (std::size_t i = 0; i < t.size(); ++i) {
+  for (std::size_t i = 0; i < orientation.t.size(); ++i) {
     const std::vector<double>& m = orientation.values[i];
     SO3::Element r;
     r << m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8];
     raw.push_back(r);
-    reference.push_back(gyro_at(gyroscope, t[i]));
+    reference.push_back(gyro_at(gyroscope, orientation.t[i]));
   }
-
   std::printf("x-IMU recording: %zu orientation samples over %.1f s; gyroscope RMS %.3f rad/s\n\n",
-              t.size(), t.back() - t.front(),
-              rms_error(reference, std::vector<Vector3>(t.size(), Vector3::Zero())));
-  std::printf(
-      "| orientation noise (rad) | finite differences RMS (rad/s) | bireg RMS (rad/s) | "
-      "bireg bandwidth (s) | GN iterations per query |\n");
-  std::printf("|---|---|---|---|---|\n");
+              raw.size(), orientation.t.back() - orientation.t.front(),
+              rms_error(reference, std::vector<Vector3>(raw.size(), Vector3::Zero())));
+  const char* header =
+      "| recording | orientation noise (rad) | finite differences RMS (rad/s) | chart line "
+      "RMS, best bandwidth (s) | bireg RMS (rad/s) | bireg bandwidths, pose and velocity (s) "
+      "| GN iterations per query |\n|---|---|---|---|---|---|---|\n";
+  std::printf("%s", header);
   std::mt19937 rng(20261123);
   std::normal_distribution<double> normal(0.0, 1.0);
   const std::string plot_path = argc > 1 ? argv[1] : "gyro_demo.svg";
-  for (const double noise : {0.0, 0.005, 0.02}) {
-    std::vector<SO3::Element> noisy = raw;
-    for (SO3::Element& r : noisy) {
-      const Vector3 e(normal(rng), normal(rng), normal(rng));
-      r = SO3::compose(r, SO3::exp(noise * e));
-    }
-    const std::vector<Vector3> differences = finite_differences(noisy, t);
-    const Smoothed smoothed = smooth(noisy, t);
-    if (smoothed.velocity.empty() || smoothed.failed > 0) {
-      std::fprintf(stderr, "gyro_demo: the local regression failed at noise %g (%d queries)\n",
-                   noise, smoothed.failed);
-      return 1;
-    }
-    std::printf("| %g | %.3f | %.3f | %.4f | %.2f |\n", noise, rms_error(differences, reference),
-                rms_error(smoothed.velocity, reference), smoothed.bandwidth,
-                smoothed.mean_iterations);
-    if (noise == 0.02 && !write_plot_svg(plot_path, 20.0, 22.0, noise, t, reference, differences,
-                                         smoothed.velocity)) {
-      return 1;
+  for (const double hz : {128.0, 50.0, 25.0}) {
+    const std::vector<std::size_t> kept = subsample(orientation.t, hz);
+    for (const double noise : {0.0, 0.005, 0.02}) {
+      std::vector<SO3::Element> r;
+      std::vector<double> t;
+      std::vector<Vector3> truth;
+      for (const std::size_t i : kept) {
+        const Vector3 e(normal(rng), normal(rng), normal(rng));
+        r.push_back(SO3::compose(raw[i], SO3::exp(noise * e)));
+        t.push_back(orientation.t[i]);
+        truth.push_back(reference[i]);
+      }
+      char label[40];
+      std::snprintf(label, sizeof label, "x-IMU at %g Hz", hz);
+      const std::vector<Vector3> smoothed = print_row(label, noise, r, t, truth);
+      if (smoothed.empty()) return 1;
+      if (hz == 128.0 && noise == 0.02 &&
+          !write_plot_svg(plot_path, 20.0, 22.0, noise, t, truth, finite_differences(r, t),
+                          smoothed)) {
+        return 1;
+      }
     }
   }
-  std::printf("\nplot (20-22 s, noise 0.02 rad): %s\n", plot_path.c_str());
+  std::printf("\nSimulated (bireg/testing/fast_motion.hpp: the truth is the simulated rate)\n\n%s",
+              header);
+  namespace motion = bireg::testing;
+  for (const double noise : {0.0, 0.005, 0.02}) {
+    for (const double speed : {5.0, 10.0, 20.0}) {
+      for (const double hz : {25.0, 50.0, 100.0}) {
+        const motion::RotationTrack track =
+            motion::sample_rotation(motion::spin(speed), 4.0, hz, noise, 11);
+        char label[48];
+        std::snprintf(label, sizeof label, "spin %g rad/s at %g Hz", speed, hz);
+        if (print_row(label, noise, track.f, track.t, track.velocity).empty()) return 1;
+      }
+    }
+    for (const double hz : {60.0, 120.0}) {
+      const motion::RotationTrack track =
+          motion::sample_rotation(motion::whip(), 2.0, hz, noise, 13);
+      char label[48];
+      std::snprintf(label, sizeof label, "whip to 16 rad/s at %g Hz", hz);
+      if (print_row(label, noise, track.f, track.t, track.velocity).empty()) return 1;
+    }
+  }
+  std::printf("\nplot (128 Hz, 20-22 s, noise 0.02 rad): %s\n", plot_path.c_str());
   return 0;
 }
