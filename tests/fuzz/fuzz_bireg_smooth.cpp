@@ -17,9 +17,9 @@
 //   * every line on stderr names the tool, is printable and bounded;
 //   * otherwise the smoothed trajectory and the velocity CSV's numbers
 //     hold no nan or inf, and the CSV has a header and one line per query,
-//     each ending in its status: as many "ok" as output poses (a failed
-//     query's pose is left out; a matrix-format pose is one line, the
-//     other formats' too), and all "ok" on exit 0.
+//     each ending in its status, at least as many as output poses (a
+//     failed query's pose is left out; a matrix-format pose is one line,
+//     the other formats' too), and on exit 0 all "ok", one per pose.
 //
 // Build and run (clang): see fuzz_fit.cpp, target fuzz_bireg_smooth,
 // corpus tests/fuzz/corpus_fuzz_bireg_smooth.
@@ -101,8 +101,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       start = end + 1;
     }
     bireg_fuzz::require_finite_text(numbers);
-    require(ok_rows == poses);
-    require(run.exit_code != 0 || rows == poses);
+    // The velocity may come from its own bandwidth's pass: a row can fail
+    // there and keep its pose, or fail for its pose and keep its velocity.
+    require(ok_rows <= rows && poses <= rows);
+    require(run.exit_code != 0 || (ok_rows == rows && poses == rows));
   }
   return 0;
 }
