@@ -33,8 +33,9 @@
 // Options::max_turn (local_window.hpp), so a geodesic through it stays in
 // the principal log's domain whatever the bandwidth; a local fit that still
 // fails is refitted cold and then on narrower windows (estimate_at), and a
-// query that fails at every width says so in its status, never with a
-// number that looks like an estimate.
+// query that fails at every width says so: ok() is false and `message`
+// says why (its pose and velocity are the last iterate's, for diagnosis,
+// not an estimate).
 //
 // Options::robust makes every query a robust fit (statistics/robust.hpp).
 #pragma once
