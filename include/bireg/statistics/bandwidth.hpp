@@ -102,6 +102,48 @@ typename G::Scalar generalised_variance(
   return exp(sum_logs / Scalar(rank));
 }
 
+// Whether more than kMaxFailureShare of a curve's held-out fits failed;
+// `attempted` receives how many were attempted (succeeded or failed).
+template <class G>
+bool fails_too_often(const HeldOut<G>& curve, std::size_t& attempted) {
+  attempted = curve.failures;
+  for (const char ok : curve.ok)
+    attempted += ok ? 1 : 0;
+  return static_cast<double>(curve.failures) > kMaxFailureShare * static_cast<double>(attempted);
+}
+
+// The errors' scatter S = (1/M) sum e_i e_i^T over the M observations that
+// `use` keeps, with `noise` (HoldOut::chords) the shared noise added back,
+// S + 2 mean(c_i) Sigma; and (1/M) sum |e_i|^2. M = 0 leaves both zero.
+template <class G>
+struct ErrorScatter {
+  Eigen::Matrix<typename G::Scalar, G::dof, G::dof> scatter =
+      Eigen::Matrix<typename G::Scalar, G::dof, G::dof>::Zero();
+  typename G::Scalar mean_squared = 0;
+  std::size_t count = 0;
+};
+
+template <class G>
+ErrorScatter<G> error_scatter(const HeldOut<G>& curve, const std::vector<char>& use,
+                              const Eigen::Matrix<typename G::Scalar, G::dof, G::dof>* noise) {
+  using Scalar = typename G::Scalar;
+  ErrorScatter<G> out;
+  Scalar cross = 0;
+  for (std::size_t i = 0; i < use.size(); ++i) {
+    if (!use[i]) continue;
+    out.scatter.noalias() += curve.errors[i] * curve.errors[i].transpose();
+    out.mean_squared += curve.errors[i].squaredNorm();
+    if (noise) cross += curve.cross[i];
+    ++out.count;
+  }
+  if (out.count == 0) return out;
+  const Scalar count = Scalar(out.count);
+  out.scatter /= count;
+  out.mean_squared /= count;
+  if (noise) out.scatter += (Scalar(2) * cross / count) * *noise;
+  return out;
+}
+
 // The choice among `curves` (one HeldOut per grid value): refusals, the
 // common observations, the generalised variances, the minimiser's index
 // (or grid.size()). `mean_squared`, when given, receives (1/M) sum |e|^2.
@@ -111,7 +153,6 @@ std::size_t choose(const std::vector<HeldOut<G>>& curves, std::size_t n,
                    std::size_t& compared, std::vector<typename G::Scalar>* mean_squared,
                    const Eigen::Matrix<typename G::Scalar, G::dof, G::dof>* noise = nullptr) {
   using Scalar = typename G::Scalar;
-  using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
   const std::size_t k = curves.size();
   refusals.assign(k, std::string());
   criteria.assign(k, std::numeric_limits<Scalar>::infinity());
@@ -124,10 +165,7 @@ std::size_t choose(const std::vector<HeldOut<G>>& curves, std::size_t n,
       continue;
     }
     std::size_t attempted = 0;
-    for (std::size_t i = 0; i < n; ++i)
-      attempted += c.ok[i] ? 1 : 0;
-    attempted += c.failures;
-    if (static_cast<double>(c.failures) > kMaxFailureShare * static_cast<double>(attempted)) {
+    if (fails_too_often(c, attempted)) {
       refusals[j] = std::to_string(c.failures) + " of " + std::to_string(attempted) +
                     " held-out fits failed (more than a tenth); the first: " + c.first_failure;
       continue;
@@ -142,20 +180,9 @@ std::size_t choose(const std::vector<HeldOut<G>>& curves, std::size_t n,
   std::size_t best = k;
   for (std::size_t j = 0; j < k; ++j) {
     if (!refusals[j].empty()) continue;
-    Scatter scatter = Scatter::Zero();
-    Scalar sum_squares = 0;
-    Scalar cross = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!common[i]) continue;
-      scatter.noalias() += curves[j].errors[i] * curves[j].errors[i].transpose();
-      sum_squares += curves[j].errors[i].squaredNorm();
-      if (noise) cross += curves[j].cross[i];
-    }
-    scatter /= Scalar(compared);
-    // HoldOut::chords: add back the shared noise, 2 mean(c_i) Sigma.
-    if (noise) scatter += (Scalar(2) * cross / Scalar(compared)) * *noise;
-    if (mean_squared) (*mean_squared)[j] = sum_squares / Scalar(compared);
-    const Scalar variance = generalised_variance<G>(scatter);
+    const ErrorScatter<G> errors = error_scatter(curves[j], common, noise);
+    if (mean_squared) (*mean_squared)[j] = errors.mean_squared;
+    const Scalar variance = generalised_variance<G>(errors.scatter);
     if (!std::isfinite(variance)) {
       refusals[j] = "the scatter of the errors over " + std::to_string(compared) +
                     " observations is zero or not finite: its generalised variance "
@@ -258,25 +285,15 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
   // successes): past their minimum the widest windows cost the most and
   // cannot win.
   constexpr std::size_t kRisesBeforeStop = 4;
-  const auto provisional = [n](const HeldOut<G>& c, const Scatter* correction) {
-    Scatter scatter = Scatter::Zero();
-    Scalar cross = 0;
-    std::size_t count = 0;
-    for (std::size_t i = 0; c.problem.empty() && i < n; ++i) {
-      if (!c.ok[i]) continue;
-      scatter.noalias() += c.errors[i] * c.errors[i].transpose();
-      if (correction) cross += c.cross[i];
-      ++count;
-    }
-    // As choose() refuses: none compared, or too many failures.
-    const double attempted = static_cast<double>(count + c.failures);
-    if (count == 0 ||
-        static_cast<double>(c.failures) > local_regression_detail::kMaxFailureShare * attempted) {
+  const auto provisional = [](const HeldOut<G>& c, const Scatter* correction) {
+    // As choose() refuses: a refused input, too many failures, none compared.
+    std::size_t attempted = 0;
+    if (!c.problem.empty() || local_regression_detail::fails_too_often(c, attempted)) {
       return std::numeric_limits<Scalar>::infinity();
     }
-    scatter /= Scalar(count);
-    if (correction) scatter += (Scalar(2) * cross / Scalar(count)) * *correction;
-    return local_regression_detail::generalised_variance<G>(scatter);
+    const auto errors = local_regression_detail::error_scatter(c, c.ok, correction);
+    return errors.count == 0 ? std::numeric_limits<Scalar>::infinity()
+                             : local_regression_detail::generalised_variance<G>(errors.scatter);
   };
   Scalar best_pose = std::numeric_limits<Scalar>::infinity();
   Scalar best_velocity = best_pose;

@@ -454,10 +454,12 @@ class LocalGeodesicRegression {
     // outside the domain, and refitting it would multiply the worst case
     // (README, "The most a fit can cost") by the number of widths.
     // Allocates (the narrowed window), on this path only.
+    // When the first fit had no previous geodesic it already was fit() on
+    // this window: narrow straight away instead of repeating it.
     std::optional<Geodesic<G>> cold;
     Estimate attempt;
-    Window narrowed = window;
-    while (true) {
+    Window narrowed = previous ? window : halved(window, tau);
+    while (narrowed.covariates.size() >= 3) {
       estimate_in(tau, narrowed, cold, buffers, attempt);
       attempt.iterations += estimate.iterations;
       if (attempt.ok()) {
@@ -467,22 +469,24 @@ class LocalGeodesicRegression {
         return;
       }
       estimate.iterations = attempt.iterations;
-      Scalar reach = 0;
-      for (const Scalar t : narrowed.covariates) {
-        using std::abs;
-        reach = std::max(reach, abs(t - tau));
-      }
-      Window kept;
-      for (std::size_t i = 0; i < narrowed.covariates.size(); ++i) {
-        using std::abs;
-        if (!(abs(narrowed.covariates[i] - tau) < reach / 2)) continue;
-        kept.observations.push_back(narrowed.observations[i]);
-        kept.covariates.push_back(narrowed.covariates[i]);
-        kept.weights.push_back(narrowed.weights[i]);
-      }
-      if (kept.covariates.size() < 3) return;
-      narrowed = std::move(kept);
+      narrowed = halved(narrowed, tau);
     }
+  }
+
+  // The observations of `window` within half its reach of tau.
+  static Window halved(const Window& window, Scalar tau) {
+    using std::abs;
+    Scalar reach = 0;
+    for (const Scalar t : window.covariates)
+      reach = std::max(reach, abs(t - tau));
+    Window kept;
+    for (std::size_t i = 0; i < window.covariates.size(); ++i) {
+      if (!(abs(window.covariates[i] - tau) < reach / 2)) continue;
+      kept.observations.push_back(window.observations[i]);
+      kept.covariates.push_back(window.covariates[i]);
+      kept.weights.push_back(window.weights[i]);
+    }
+    return kept;
   }
 
   // One attempt at tau on `window`: the warm fit from `previous`, else a
