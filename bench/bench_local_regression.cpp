@@ -18,6 +18,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/local_regression.hpp"
+#include "bireg/testing/random.hpp"
 
 namespace {
 
@@ -41,7 +42,7 @@ Data curve(int n) {
     const double t = i * kSpacing;
     const G::Tangent c =
         0.5 * G::Tangent(std::sin(w * t), std::cos(w * t) - 1, std::sin(2 * w * t));
-    const G::Tangent e(normal(rng), normal(rng), normal(rng));
+    const G::Tangent e = bireg::testing::draw_vector<G::Tangent>(rng, normal);
     data.t.push_back(t);
     data.f.push_back(G::compose(G::exp(c), G::exp(e)));
   }

@@ -23,6 +23,7 @@
 #include "bireg/statistics/local_regression.hpp"
 #include "bireg/statistics/model_selection.hpp"
 #include "bireg/statistics/trend_test.hpp"
+#include "bireg/testing/random.hpp"
 
 namespace {
 
@@ -93,7 +94,7 @@ void BM_SmoothThreads(benchmark::State& state) {
     const SO3::Tangent curve =
         0.5 * SO3::Tangent(std::sin(w * ti), std::cos(w * ti) - 1, std::sin(2 * w * ti));
     f.push_back(SO3::compose(SO3::exp(curve),
-                             SO3::exp(SO3::Tangent(normal(rng), normal(rng), normal(rng)))));
+                             SO3::exp(bireg::testing::draw_vector<SO3::Tangent>(rng, normal))));
     t.push_back(ti);
   }
   bireg::LocalRegressionOptions<double> options;

@@ -21,6 +21,7 @@
 
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/testing/random.hpp"
 
 // The whole definition of the group: a basis of the algebra and a test.
 struct UnitriangularBasis {
@@ -57,7 +58,7 @@ int main() {
   std::vector<double> times;
   for (int i = 0; i < 40; ++i) {
     const double t = 0.25 * i;  // seconds
-    const G::Tangent e(noise(rng), noise(rng), noise(rng));
+    const G::Tangent e = bireg::testing::draw_vector<G::Tangent>(rng, noise);
     observations.push_back(G::compose(G::compose(g0, G::exp((t / 9.75) * x)), G::exp(e)));
     times.push_back(t);
   }

@@ -235,7 +235,7 @@ int main(int argc, char** argv) {
       std::vector<double> t;
       std::vector<Vector3> truth;
       for (const std::size_t i : kept) {
-        const Vector3 e(normal(rng), normal(rng), normal(rng));
+        const Vector3 e = bireg::testing::draw_vector<Vector3>(rng, normal);
         r.push_back(SO3::compose(raw[i], SO3::exp(noise * e)));
         t.push_back(orientation.t[i]);
         truth.push_back(reference[i]);

@@ -29,6 +29,7 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/io/line_reader.hpp"
 #include "bireg/statistics/model_selection.hpp"
+#include "bireg/testing/random.hpp"
 
 namespace {
 
@@ -85,12 +86,14 @@ void straight_drive(std::vector<Eigen::Matrix4d>& poses, std::vector<double>& ti
   std::normal_distribution<double> normal(0.0, 1.0);
   for (int i = 0; i < 100; ++i) {
     const double t = 0.1 * i;
-    const Eigen::Vector3d attitude(
-        0.3 * kDegree * std::sin(2.1 * t) + 0.2 * kDegree * normal(rng),
-        0.3 * kDegree * std::sin(1.3 * t + 1) + 0.2 * kDegree * normal(rng),
-        0.2 * kDegree * normal(rng));
-    const Eigen::Vector3d position(kSpeed * t + 0.05 * normal(rng), 0.05 * normal(rng),
-                                   0.05 * normal(rng));
+    const Eigen::Vector3d attitude_noise =
+        0.2 * kDegree * bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal);
+    const Eigen::Vector3d position_noise =
+        0.05 * bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal);
+    const Eigen::Vector3d attitude = Eigen::Vector3d(0.3 * kDegree * std::sin(2.1 * t),
+                                                     0.3 * kDegree * std::sin(1.3 * t + 1), 0.0) +
+                                     attitude_noise;
+    const Eigen::Vector3d position = Eigen::Vector3d(kSpeed * t, 0.0, 0.0) + position_noise;
     Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
     pose.topLeftCorner<3, 3>() = bireg::SO3d::exp(attitude);
     pose.topRightCorner<3, 1>() = position;

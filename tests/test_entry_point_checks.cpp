@@ -30,6 +30,7 @@
 #include "bireg/statistics/distributions.hpp"
 #include "bireg/statistics/model_selection.hpp"
 #include "bireg/statistics/robust.hpp"
+#include "bireg/testing/random.hpp"
 #include "catch.hpp"
 
 namespace {
@@ -233,8 +234,8 @@ TEST_CASE("enumerations out of range are refused with a message (issue 37 item 2
   std::vector<double> times;
   for (int i = 0; i < 30; ++i) {
     const double t = i / 29.0;
-    rotations.push_back(
-        SO3d::exp(Eigen::Vector3d(0.5 * t + normal(rng), normal(rng), -0.3 * t + normal(rng))));
+    const Eigen::Vector3d e = bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal);
+    rotations.push_back(SO3d::exp(Eigen::Vector3d(0.5 * t, 0.0, -0.3 * t) + e));
     times.push_back(t);
   }
 
@@ -413,7 +414,7 @@ TEST_CASE("static or geodesic refuses covariates that are not finite or overflow
   std::vector<Eigen::Matrix3d> rotations;
   std::vector<double> clean_times;
   for (int i = 0; i < 30; ++i) {
-    rotations.push_back(SO3d::exp(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))));
+    rotations.push_back(SO3d::exp(bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal)));
     clean_times.push_back(i);
   }
   REQUIRE(bireg::select_static_or_geodesic<SO3d>(rotations, clean_times).ok());
@@ -458,7 +459,7 @@ TEST_CASE("static data at nanosecond covariates far from zero are static (issue 
   const Eigen::Matrix3d centre = SO3d::exp(Eigen::Vector3d(0.4, -0.7, 1.1));
   std::vector<Eigen::Matrix3d> rotations;
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d e(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d e = bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal);
     rotations.push_back(SO3d::compose(centre, SO3d::exp(e)));
   }
   const auto at_offset = [&](double offset) {

@@ -63,10 +63,14 @@ Velocities auto_velocity(const RotationTrack& track) {
 // The bounds bireg does not meet yet, measured (2026-11-25, figures in
 // the README's gyroscope table): at 25 Hz a 10-20 rad/s spin leaves 2-3
 // samples per window (the turn allows no more), and the chart line, which
-// may span 5 rad, averages more of them; the whip's noisy 120 Hz rows and
-// a 20 rad/s spin at 50 Hz with 0.02 rad are 1.2-1.5x the chart line at
-// its best bandwidth; on the x-IMU recording even that chart line is
-// 0.6-1.0x finite differences, so 0.5x is out of any smoother's reach.
+// may span 5 rad, averages more of them; the whip's noisy rows and a
+// 20 rad/s spin at 50 Hz with 0.02 rad are 1.2-1.5x the chart line at its
+// best bandwidth; at 100 Hz with 0.02 rad the chords' noise (1.4 rad/s
+// per axis) swamps the velocity's error (0.13) in the velocity's
+// criterion, and on this sample of a 10 rad/s spin it picks the pose's
+// bandwidth, 1.5x the chart line at its best; on the x-IMU recording even
+// that chart line is 0.6-1.0x finite differences, so 0.5x is out of any
+// smoother's reach.
 struct Gap {
   const char* name;
   const char* bound;
@@ -74,6 +78,7 @@ struct Gap {
 const Gap kKnownGaps[] = {
     {"spin 10 rad/s at 25 Hz, noise 0.005", "0.5 differences"},
     {"spin 20 rad/s at 25 Hz, noise 0.005", "0.5 differences"},
+    {"spin 20 rad/s at 25 Hz, noise 0.005", "1.15 chart"},
     {"whip 16 rad/s at 60 Hz, noise 0.005", "1.15 chart"},
     {"whip 16 rad/s at 120 Hz, noise 0.005", "1.15 chart"},
     {"spin 10 rad/s at 25 Hz, noise 0.02", "1.15 chart"},
@@ -81,6 +86,7 @@ const Gap kKnownGaps[] = {
     {"spin 20 rad/s at 25 Hz, noise 0.02", "1.15 chart"},
     {"spin 20 rad/s at 25 Hz, noise 0.02", "0.5 differences"},
     {"spin 20 rad/s at 50 Hz, noise 0.02", "1.15 chart"},
+    {"spin 10 rad/s at 100 Hz, noise 0.02", "1.15 chart"},
     {"whip 16 rad/s at 120 Hz, noise 0.02", "1.15 chart"},
     {"x-IMU at 50 Hz, noise 0.005", "0.5 differences"},
     {"x-IMU at 25 Hz, noise 0.005", "0.5 differences"},
@@ -176,7 +182,7 @@ RotationTrack subsampled_xio(double hz, double noise, unsigned seed) {
     next += 1.0 / hz;
     SO3::Element r;
     r << row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9];
-    const SO3::Tangent e(normal(rng), normal(rng), normal(rng));
+    const SO3::Tangent e = bireg::testing::draw_vector<SO3::Tangent>(rng, normal);
     track.f.push_back(SO3::compose(r, SO3::exp(noise * e)));
     track.t.push_back(t);
     while (g + 1 < gyroscope.size() && gyroscope[g][0] < t)
@@ -233,8 +239,8 @@ TEST_CASE("The x-IMU recording at 50 and 25 Hz against its own gyroscope", "[fas
 // The known gaps, run and reported, expected to fail until fixed.
 TEST_CASE("Known gaps against the issue's bounds", "[fast][!mayfail]") {
   for (const double noise : kNoises) {
-    for (const double speed : {10.0, 20.0}) {
-      for (const double hz : {25.0, 50.0}) {
+    for (const double speed : {5.0, 10.0, 20.0}) {
+      for (const double hz : {25.0, 50.0, 100.0}) {
         const std::string name = case_name(spin_name(speed), hz, noise);
         if (!has_gap(name)) continue;
         SECTION(name) {
@@ -320,16 +326,21 @@ TEST_CASE("Cut windows keep the local fit left and right equivariant on SE(3)", 
   }
 }
 
-// Boundary: a rotation whose rate grows linearly, w(t) = (2 + 6t, -3t, 1)
-// rad/s, 101 samples over 1 s with noise 0.01 rad, bandwidth 0.05 s. At
-// the ends the window is one-sided and a local line's slope is off by
-// about w'(t) times the window's mean offset, 6 rad/s^2 x 0.08 s = 0.5 rad/s
-// (the local line has no first-order bias in the pose, only in its
-// derivative). The quadratic correction removes it: the end estimates lie
-// within 3 standard errors of the truth per coordinate, while the
-// geodesic's velocity alone does not.
+// Boundary: a rotation whose rate grows linearly, w(t) = (2 + 12t, -3t, 1)
+// rad/s, 101 samples over 1 s with noise 0.01 rad, bandwidth h = 0.05 s. At
+// an end the window is one-sided: offsets s >= 0 weighted by a half
+// Gaussian, whose moments are E s = 0.80 h, E s^2 = h^2, E s^3 = 1.60 h^3.
+// A least-squares line through y(s) = y0 + w s + w' s^2 / 2 has the slope
+// w + (w'/2) Cov(s, s^2) / Var(s) = w + (w'/2) (0.80 h / 0.36) = w + 1.1 w' h:
+// 0.66 rad/s off on the first axis here (the local line has no first-order
+// bias in the pose, only in its derivative), about 5 of the slope's
+// standard errors (0.12 rad/s). The quadratic correction removes it: the
+// end estimates lie within 3 standard errors of the truth per coordinate,
+// while the geodesic's velocity alone is more than 3 away. (With w' = 6 the
+// bias, 0.33 rad/s, was within a standard error of the 3-error line, and
+// which side of it one sample fell on decided the test.)
 TEST_CASE("At the ends of the data the velocity has no first-order bias", "[fast]") {
-  const motion::AngularRate rate = [](double t) { return SO3::Tangent(2 + 6 * t, -3 * t, 1.0); };
+  const motion::AngularRate rate = [](double t) { return SO3::Tangent(2 + 12 * t, -3 * t, 1.0); };
   const RotationTrack track = motion::sample_rotation(rate, 1.0, 100.0, 0.01, 21);
   bireg::LocalRegressionOptions<double> options;
   options.bandwidth = 0.05;

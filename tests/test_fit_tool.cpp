@@ -1237,7 +1237,7 @@ TEST_CASE("bireg_fit reports a converged fit of data turning beyond pi", "[tool]
   std::mt19937 rng(11);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (int attempt = 0; attempt < 50; ++attempt) {
-    G::Tangent x(normal(rng), normal(rng), normal(rng));
+    G::Tangent x = bireg::testing::draw_vector<G::Tangent>(rng, normal);
     x *= (6.0 + 6.0 * attempt / 50.0) / x.norm();
     std::vector<G::Element> f;
     std::vector<double> t;
@@ -1286,10 +1286,10 @@ std::string tum_scene(bool rotates, bool translates, unsigned seed) {
     const double u = i / 59.0;
     const Eigen::Matrix3d r =
         Eigen::AngleAxisd(rotates ? 1.2 * u : 0.0, axis).toRotationMatrix() *
-        bireg::SO3<double>::exp(Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+        bireg::SO3<double>::exp(bireg::testing::draw_vector<Eigen::Vector3d>(rng, noise));
     const Eigen::Vector3d p = Eigen::Vector3d(1.0, 2.0, 0.5) +
                               (translates ? u : 0.0) * Eigen::Vector3d(3.0, -1.0, 0.2) +
-                              Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+                              bireg::testing::draw_vector<Eigen::Vector3d>(rng, noise);
     const Eigen::Quaterniond q(r);
     text += g17(t) + " " + g17(p.x()) + " " + g17(p.y()) + " " + g17(p.z()) + " " + g17(q.x()) +
             " " + g17(q.y()) + " " + g17(q.z()) + " " + g17(q.w()) + "\n";

@@ -13,6 +13,7 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/model_selection.hpp"
+#include "bireg/testing/random.hpp"
 #include "catch.hpp"
 
 namespace {
@@ -330,7 +331,7 @@ RotationScene rotation_scene(bool moves, std::mt19937& rng) {
   RotationScene scene;
   for (int i = 0; i < kObservations; ++i) {
     const double t = static_cast<double>(i) / (kObservations - 1);
-    const Eigen::Vector3d e(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d e = bireg::testing::draw_vector<Eigen::Vector3d>(rng, normal);
     scene.rotations.push_back(r0 * bireg::SO3d::exp((moves ? t : 0.0) * omega) *
                               bireg::SO3d::exp(e));
     scene.times.push_back(t);

@@ -105,7 +105,7 @@ TEST_CASE("on Rn the fit is the weighted least-squares line", "[regression][comm
   for (int i = 0; i < 30; ++i) {
     const double ti = 100 + 50 * (uniform(rng) + 1);  // unsorted, user units
     t.push_back(ti);
-    f.push_back(alpha + beta * ti + G::Element(uniform(rng), uniform(rng), uniform(rng)));
+    f.push_back(alpha + beta * ti + bireg::testing::draw_vector<G::Element>(rng, uniform));
     w.push_back(0.5 + (uniform(rng) + 1));
   }
   // Closed form, in the user's units.
@@ -202,8 +202,10 @@ TEST_CASE("on Rn and SO2 the error contracts exactly by (1 - lambda mu_min)^n",
     {
       using G = bireg::Rn<2, double>;
       std::vector<G::Element> f;
-      for (double ti : t)
-        f.push_back(G::Element(0.5 * ti + 0.1 * uniform(rng), -ti + 0.1 * uniform(rng)));
+      for (double ti : t) {
+        const Eigen::Vector2d e = bireg::testing::draw_vector<Eigen::Vector2d>(rng, uniform);
+        f.push_back(G::Element(0.5 * ti + 0.1 * e[0], -ti + 0.1 * e[1]));
+      }
       check_commutative_rate<G>(f, t, lambda_fraction);
     }
     {
@@ -392,7 +394,8 @@ TEST_CASE("the iteration contracts at the rate of the theorem", "[regression][ra
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Tangent> directions;
   for (int i = 0; i < kN; ++i) {
-    directions.push_back(unit(rng) * bireg_test::random_unit<3>(rng).cast<double>());
+    const double length = unit(rng);
+    directions.push_back(length * bireg_test::random_unit<3>(rng).cast<double>());
   }
   std::vector<double> t;
   for (int i = 0; i < kN; ++i)

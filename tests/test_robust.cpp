@@ -19,6 +19,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/robust.hpp"
+#include "bireg/testing/random.hpp"
 #include "catch.hpp"
 
 namespace {
@@ -44,7 +45,8 @@ struct Data {
 // A Haar-random rotation: the normalised quaternion of four standard normals.
 Eigen::Matrix3d random_rotation(std::mt19937& rng) {
   std::normal_distribution<double> normal(0, 1);
-  const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+  const Eigen::Vector4d wxyz = bireg::testing::draw_vector<Eigen::Vector4d>(rng, normal);
+  const Eigen::Quaterniond q(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
   return q.normalized().toRotationMatrix();
 }
 
@@ -58,7 +60,7 @@ typename G::Element random_element(std::mt19937& rng) {
     std::uniform_real_distribution<double> uniform(-2, 2);
     Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
     pose.topLeftCorner<3, 3>() = random_rotation(rng);
-    pose.topRightCorner<3, 1>() = Eigen::Vector3d(uniform(rng), uniform(rng), uniform(rng));
+    pose.topRightCorner<3, 1>() = bireg::testing::draw_vector<Eigen::Vector3d>(rng, uniform);
     return pose;
   }
 }

@@ -131,7 +131,8 @@ TEMPLATE_TEST_CASE("Sim3 exp and log are accurate over log-scales and angles", "
   std::uniform_real_distribution<double> angle_exponent(-10.0, std::log10(3.1));
   std::bernoulli_distribution negative(0.5);
   for (int sample = 0; sample < 4000; ++sample) {
-    const double sigma = (negative(rng) ? -1 : 1) * std::pow(10.0, exponent(rng));
+    const double sign = negative(rng) ? -1 : 1;
+    const double sigma = sign * std::pow(10.0, exponent(rng));
     check(sigma, std::pow(10.0, angle_exponent(rng)));
   }
   if (report()) {

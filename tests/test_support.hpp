@@ -11,6 +11,7 @@
 
 #include "bireg/groups/so3.hpp"
 #include "bireg/testing/group_laws.hpp"
+#include "bireg/testing/random.hpp"
 
 namespace bireg_test {
 
@@ -67,7 +68,7 @@ inline So3Trajectory dense_so3_trajectory(int n, double noise, unsigned seed) {
     const double t = i * 1e-3;
     const SO3::Tangent curve =
         0.5 * SO3::Tangent(std::sin(omega * t), std::cos(omega * t) - 1, std::sin(2 * omega * t));
-    const SO3::Tangent e(normal(rng), normal(rng), normal(rng));
+    const SO3::Tangent e = bireg::testing::draw_vector<SO3::Tangent>(rng, normal);
     data.f.push_back(SO3::compose(SO3::exp(curve), SO3::exp(e)));
     data.t.push_back(t);
   }

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "bireg/groups/so3.hpp"
+#include "bireg/testing/random.hpp"
 
 namespace bireg::testing {
 
@@ -54,7 +55,7 @@ inline RotationTrack sample_rotation(const AngularRate& rate, double duration, d
     }
     if (t_i > now) r = SO3::compose(r, SO3::exp(rate((now + t_i) / 2) * (t_i - now)));
     now = t_i;
-    const SO3::Tangent e(normal(rng), normal(rng), normal(rng));
+    const SO3::Tangent e = draw_vector<SO3::Tangent>(rng, normal);
     track.f.push_back(SO3::compose(r, SO3::exp(noise * e)));
     track.t.push_back(t_i);
     track.velocity.push_back(rate(t_i));
