@@ -16,7 +16,7 @@
 // then unchanged by left and right translation, inversion and exchanging
 // the samples (docs/cohorts.md, Theorem). The published variant (S_B' =
 // S_B, Hanik, Hege and von Tycowicz's definition) is unchanged by
-// translations only.
+// translations and exchange, not by inversion.
 //
 // p = (1 + #{b : T_b >= T}) / (B + 1) over B relabellings of the pooled
 // sample, each with both means recomputed (the exact mode). Relabelling b
@@ -48,12 +48,12 @@ namespace bireg {
 enum class TwoSampleStatistic {
   hotelling,      // T^2: most sensitive to a difference of means
   bhattacharyya,  // D_B: differences of means and of covariances
-  hellinger,      // H^2 = 1 - exp(-D_B): the same test as D_B, another scale
+  hellinger,      // H^2 = 1 - exp(-D_B): the same test as D_B (ranked by D_B), another scale
 };
 
 enum class TwoSampleVariant {
   invariant,  // B's coordinates transported to m_A: invariant under inversion too
-  published,  // B's covariance at m_B: invariant under left and right translation only
+  published,  // B's covariance at m_B: invariant under translations and exchange, not inversion
 };
 
 inline const char* to_string(TwoSampleStatistic statistic) {
@@ -150,8 +150,8 @@ std::optional<typename Matrix::Scalar> log_determinant(const Matrix& s) {
   return lambda.array().log().sum();
 }
 
-// The chosen statistic from the sizes, S_A, S_B' and c; nullopt when a
-// covariance it needs is singular.
+// T^2 (hotelling) or D_B (otherwise) from the sizes, S_A, S_B' and c;
+// nullopt when a covariance it needs is singular.
 template <class G>
 std::optional<typename G::Scalar> statistic(TwoSampleStatistic which, std::size_t m, std::size_t n,
                                             const typename G::AdMatrix& s_a,
@@ -172,9 +172,8 @@ std::optional<typename G::Scalar> statistic(TwoSampleStatistic which, std::size_
   if (!log_a || !log_b || !log_average) return std::nullopt;
   const Scalar form = c.dot(average.ldlt().solve(c));
   const Scalar bhattacharyya = form / 8 + (*log_average - (*log_a + *log_b) / 2) / 2;
-  if (which == TwoSampleStatistic::bhattacharyya) return bhattacharyya;
-  using std::expm1;
-  return -expm1(-bhattacharyya);  // 1 - exp(-D_B) without cancellation near 0
+  // Hellinger too: two_sample_test ranks it by D_B and reports 1 - exp(-D_B).
+  return bhattacharyya;
 }
 
 template <class G>
@@ -402,13 +401,19 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
   for (const auto& z : pooled.z)
     pooled.jacobian.push_back(right_jacobian_inverse<G>(-z));
 
+  // Hellinger's H^2 = 1 - exp(-D_B) is ranked on D_B's scale: the same
+  // verdicts, without the rounding of H^2 to 1 where D_B exceeds ~37.
+  TwoSampleOptions<Scalar> ranking = options;
+  if (options.statistic == TwoSampleStatistic::hellinger) {
+    ranking.statistic = TwoSampleStatistic::bhattacharyya;
+  }
   // The observed split by the same arithmetic as the relabelled ones, so
   // that T is exchangeable with the T_b under H0.
   std::vector<std::size_t> identity(m + n);
   for (std::size_t i = 0; i < m + n; ++i)
     identity[i] = i;
   detail::Split<G> observed;
-  detail::evaluate<G>(pooled, identity.data(), m, n, options, observed);
+  detail::evaluate<G>(pooled, identity.data(), m, n, ranking, observed);
   result.mean_a = observed.value ? observed.mean_a : *mean_a.mean;
   result.mean_b = observed.value ? observed.mean_b : *mean_b.mean;
   result.mean_difference = observed.c;
@@ -422,12 +427,15 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
                      sizes;
     return result;
   }
-  result.value = *observed.value;
+  const Scalar observed_value = *observed.value;
+  using std::expm1;
+  result.value = options.statistic == TwoSampleStatistic::hellinger ? -expm1(-observed_value)
+                                                                     : observed_value;
 
   const std::size_t count = static_cast<std::size_t>(options.permutations);
   std::vector<detail::Verdict> verdicts(count, detail::Verdict::failed);
   const std::size_t blocks = (count + detail::kBlock - 1) / detail::kBlock;
-  const Scalar threshold = result.value * (1 - detail::kTie<Scalar>);
+  const Scalar threshold = observed_value * (1 - detail::kTie<Scalar>);
   const auto run_block = [&](std::size_t block) {
     std::vector<std::size_t> order;
     detail::Split<G> split;
@@ -436,7 +444,7 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
     const std::size_t end = std::min(count, (block + 1) * detail::kBlock);
     for (std::size_t b = block * detail::kBlock; b < end; ++b) {
       permutation(options.seed, b, m + n, order);
-      detail::evaluate<G>(pooled, order.data(), m, n, options, split);
+      detail::evaluate<G>(pooled, order.data(), m, n, ranking, split);
       verdicts[b] = !split.value                ? detail::Verdict::failed
                     : *split.value >= threshold ? detail::Verdict::at_least_as_extreme
                                                 : detail::Verdict::less_extreme;
