@@ -227,7 +227,7 @@ TEST_CASE("The population trend's confidence region has its coverage",
   CHECK(flagged <= 40);
 }
 
-TEST_CASE("An outlying subject is flagged; too few subjects are refused",
+TEST_CASE("An outlying subject is flagged and too few subjects are refused",
           "[cohorts][trends][hostile]") {
   std::mt19937 rng(5);
   const Population population{SO3::identity(), SO3::exp(SO3::Tangent(0.5, 0, 0))};

@@ -490,7 +490,7 @@ TEMPLATE_TEST_CASE("the covariance in the algebra of ad_X equals the matrix pass
   }
 }
 
-TEMPLATE_TEST_CASE("the exact K matches finite differences of the force; the series K is close",
+TEMPLATE_TEST_CASE("the exact K matches finite differences of the force and the series K is close",
                    "[statistics][covariance]", bireg::SO3d, bireg::SE3d) {
   using G = TestType;
   using Tangent = typename G::Tangent;

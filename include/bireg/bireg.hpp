@@ -16,6 +16,7 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/statistics/cohorts/elementwise.hpp"
 #include "bireg/statistics/cohorts/trends.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
 #include "bireg/statistics/confidence.hpp"

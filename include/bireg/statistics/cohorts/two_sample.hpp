@@ -309,6 +309,41 @@ inline constexpr std::size_t kBlock = 16;
 
 enum class Verdict : unsigned char { less_extreme, at_least_as_extreme, failed };
 
+// Why options and sample sizes m, n cannot be tested (`sizes` describes
+// them for the message); empty when they can.
+template <class G>
+std::string refusal(std::size_t m, std::size_t n,
+                    const TwoSampleOptions<typename G::Scalar>& options, const std::string& sizes) {
+  const std::size_t d = static_cast<std::size_t>(G::dof);
+  const int which = static_cast<int>(options.statistic);
+  if (which < 0 || which > static_cast<int>(TwoSampleStatistic::hellinger)) {
+    return "statistic " + std::to_string(which) + " is not a TwoSampleStatistic";
+  }
+  const int variant = static_cast<int>(options.variant);
+  if (variant < 0 || variant > static_cast<int>(TwoSampleVariant::published)) {
+    return "variant " + std::to_string(variant) + " is not a TwoSampleVariant";
+  }
+  if (options.permutations < 0 || options.permutations > kMaxTwoSamplePermutations) {
+    return "permutations must be 0 to " + std::to_string(kMaxTwoSamplePermutations) + ", not " +
+           std::to_string(options.permutations);
+  }
+  if (options.threads < 1 || options.threads > kMaxThreads) {
+    return "threads must be 1 to " + std::to_string(kMaxThreads) + ", not " +
+           std::to_string(options.threads);
+  }
+  if (m < 2 || n < 2) return "each sample needs at least two elements; there are " + sizes;
+  if (options.statistic == TwoSampleStatistic::hotelling && m + n - 2 < d) {
+    return "the pooled covariance is singular: it needs m + n - 2 >= " + std::to_string(d) +
+           ", and there are " + sizes;
+  }
+  if (options.statistic != TwoSampleStatistic::hotelling && (m <= d || n <= d)) {
+    return std::string("each sample's covariance is singular unless it has more than ") +
+           std::to_string(d) + " elements (" + to_string(options.statistic) +
+           " needs both); there are " + sizes;
+  }
+  return {};
+}
+
 }  // namespace two_sample_detail
 
 // The two-sample test of `a` against `b` (indexable, with size(); m, n >=
@@ -324,45 +359,11 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
   result.statistic = options.statistic;
   result.variant = options.variant;
   const std::size_t m = a.size(), n = b.size();
-  const std::size_t d = static_cast<std::size_t>(G::dof);
   const std::string sizes = "m = " + std::to_string(m) + " and n = " + std::to_string(n) +
-                            " elements of " + G::name + " (dimension " + std::to_string(d) + ")";
-  const int which = static_cast<int>(options.statistic);
-  if (which < 0 || which > static_cast<int>(TwoSampleStatistic::hellinger)) {
-    result.message = "statistic " + std::to_string(which) + " is not a TwoSampleStatistic";
-    return result;
-  }
-  const int variant = static_cast<int>(options.variant);
-  if (variant < 0 || variant > static_cast<int>(TwoSampleVariant::published)) {
-    result.message = "variant " + std::to_string(variant) + " is not a TwoSampleVariant";
-    return result;
-  }
-  if (options.permutations < 0 || options.permutations > kMaxTwoSamplePermutations) {
-    result.message = "permutations must be 0 to " + std::to_string(kMaxTwoSamplePermutations) +
-                     ", not " + std::to_string(options.permutations);
-    return result;
-  }
-  if (options.threads < 1 || options.threads > kMaxThreads) {
-    result.message = "threads must be 1 to " + std::to_string(kMaxThreads) + ", not " +
-                     std::to_string(options.threads);
-    return result;
-  }
-  if (m < 2 || n < 2) {
-    result.message = "each sample needs at least two elements; there are " + sizes;
-    return result;
-  }
-  if (options.statistic == TwoSampleStatistic::hotelling && m + n - 2 < d) {
-    result.message =
-        "the pooled covariance is singular: it needs m + n - 2 >= " + std::to_string(d) +
-        ", and there are " + sizes;
-    return result;
-  }
-  if (options.statistic != TwoSampleStatistic::hotelling && (m <= d || n <= d)) {
-    result.message = std::string("each sample's covariance is singular unless it has more than ") +
-                     std::to_string(d) + " elements (" + to_string(options.statistic) +
-                     " needs both); there are " + sizes;
-    return result;
-  }
+                            " elements of " + G::name + " (dimension " + std::to_string(G::dof) +
+                            ")";
+  result.message = detail::refusal<G>(m, n, options, sizes);
+  if (!result.message.empty()) return result;
 
   // The data's means, by mean(): it checks every element and says which
   // one is bad.
@@ -429,8 +430,8 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
   }
   const Scalar observed_value = *observed.value;
   using std::expm1;
-  result.value = options.statistic == TwoSampleStatistic::hellinger ? -expm1(-observed_value)
-                                                                     : observed_value;
+  result.value =
+      options.statistic == TwoSampleStatistic::hellinger ? -expm1(-observed_value) : observed_value;
 
   const std::size_t count = static_cast<std::size_t>(options.permutations);
   std::vector<detail::Verdict> verdicts(count, detail::Verdict::failed);
