@@ -367,22 +367,17 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
 
   // The data's means, by mean(): it checks every element and says which
   // one is bad.
+  const auto refused_by_mean = [&result](const MeanResult<G>& failed, char sample) {
+    result.status = failed.status;
+    result.bad_sample = failed.bad_index >= 0 ? sample : 0;
+    result.bad_index = failed.bad_index;
+    result.message = std::string("sample ") + sample + ": " + failed.message;
+    return result;
+  };
   const MeanResult<G> mean_a = mean<G>(a, {}, options.mean);
-  if (!mean_a.ok()) {
-    result.status = mean_a.status;
-    result.bad_sample = mean_a.bad_index >= 0 ? 'A' : 0;
-    result.bad_index = mean_a.bad_index;
-    result.message = "sample A: " + mean_a.message;
-    return result;
-  }
+  if (!mean_a.ok()) return refused_by_mean(mean_a, 'A');
   const MeanResult<G> mean_b = mean<G>(b, {}, options.mean);
-  if (!mean_b.ok()) {
-    result.status = mean_b.status;
-    result.bad_sample = mean_b.bad_index >= 0 ? 'B' : 0;
-    result.bad_index = mean_b.bad_index;
-    result.message = "sample B: " + mean_b.message;
-    return result;
-  }
+  if (!mean_b.ok()) return refused_by_mean(mean_b, 'B');
 
   detail::Pooled<G> pooled;
   pooled.elements.reserve(m + n);
