@@ -9,6 +9,9 @@
 // (statistics/cohorts/elementwise.hpp) of GL+(3) deformation gradients, 20
 // + 20 subjects of K elements (noise 0.1 per coordinate), 999 relabellings,
 // Hotelling, one thread; mode 0 exact, 1 linearised.
+// BM_FitMany/<threads>: fit_many (statistics/cohorts/trends.hpp) of 10,000
+// subjects of 20 SE(3) poses each; BM_FitOneByOne: the same fits by
+// GeodesicRegression::fit in a loop, the cost fit_many adds to.
 #include <random>
 #include <vector>
 
@@ -17,6 +20,7 @@
 #include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/statistics/cohorts/elementwise.hpp"
+#include "bireg/statistics/cohorts/trends.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
 #include "bireg/testing/random.hpp"
 
@@ -83,6 +87,50 @@ BENCHMARK(BM_Elementwise)
     ->Args({0, 20})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+std::vector<bireg::SubjectData<G>> study() {
+  std::mt19937 rng(10000);
+  std::normal_distribution<double> spread(0.0, 0.3), noise(0.0, 0.05);
+  std::vector<bireg::SubjectData<G>> subjects(10000);
+  for (auto& subject : subjects) {
+    const G::Element start = G::exp(bireg::testing::draw_vector<G::Tangent>(rng, spread));
+    const G::Element end =
+        G::compose(start, G::exp(G::Tangent(0.5, 0, 0, 1.0, 0, 0) +
+                                 bireg::testing::draw_vector<G::Tangent>(rng, spread)));
+    const bireg::Geodesic<G> truth(start, end);
+    for (int k = 0; k < 20; ++k) {
+      const double t = k / 19.0;
+      subject.observations.push_back(
+          G::compose(truth(t), G::exp(bireg::testing::draw_vector<G::Tangent>(rng, noise))));
+      subject.covariates.push_back(t);
+    }
+  }
+  return subjects;
+}
+
+void BM_FitMany(benchmark::State& state) {
+  const auto subjects = study();
+  bireg::FitManyOptions<double> options;
+  options.threads = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    const auto fits = bireg::fit_many(bireg::GeodesicRegression<G>(), subjects, options);
+    if (!fits.ok()) state.SkipWithError(fits.message.c_str());
+    benchmark::DoNotOptimize(fits.trends.data());
+  }
+}
+BENCHMARK(BM_FitMany)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FitOneByOne(benchmark::State& state) {
+  const auto subjects = study();
+  const bireg::GeodesicRegression<G> regression;
+  for (auto _ : state) {
+    for (const auto& subject : subjects) {
+      const auto fit = regression.fit(subject.observations, subject.covariates);
+      benchmark::DoNotOptimize(fit.iterations);
+    }
+  }
+}
+BENCHMARK(BM_FitOneByOne)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -148,6 +148,21 @@ MUTANTS = [
            "if (!result.ok() && (robust && !robust->ok())) {",
            ["test_fit_tool"],
            "exit code 0 for a fit that did not converge"),
+    Mutant("CO1", "include/bireg/statistics/cohorts/two_sample.hpp",
+           "G::Ad(G::exp(split.c / 2));",
+           "G::Ad(G::exp(-split.c / 2));",
+           ["test_cohorts"],
+           "parallel transport from m_B to m_A with the wrong sign, Ad(exp(-c/2))"),
+    Mutant("CO2", "include/bireg/statistics/cohorts/two_sample.hpp",
+           "result.p_value = Scalar(1 + result.at_least_as_extreme) / Scalar(1 + options.permutations);",
+           "result.p_value = Scalar(result.at_least_as_extreme) / Scalar(1 + options.permutations);",
+           ["test_cohorts"],
+           "the invalid permutation p-value #{T_b >= T} / (B + 1), which can be 0"),
+    Mutant("CO3", "include/bireg/statistics/cohorts/elementwise.hpp",
+           "const Scalar candidate = p[order[r]] * Scalar(k) / Scalar(r + 1);",
+           "const Scalar candidate = p[order[r]] * Scalar(k) / Scalar(k);",
+           ["test_cohort_maps"],
+           "Benjamini-Hochberg without the rank (Bonferroni's K p instead)"),
 ]
 
 

@@ -15,6 +15,7 @@
 // two_sample.hpp on G x G inherit their invariance.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -116,16 +117,22 @@ FitManyResult<G> fit_many(const GeodesicRegression<G>& regression,
   const std::size_t count = subjects.size();
   result.fits.resize(count);
   result.trends.resize(count);
-  const auto fit_subject = [&](std::size_t i) {
-    RegressionResult<G>& fit = result.fits[i];
-    fit = regression.fit(subjects[i].observations, subjects[i].covariates);
-    if (fit.ok()) result.trends[i] = {(*fit.geodesic)(t0), (*fit.geodesic)(t1)};
+  // Subjects in tasks of kSubjectsPerTask: one claim per task, not per fit.
+  constexpr std::size_t kSubjectsPerTask = 16;
+  const std::size_t tasks = (count + kSubjectsPerTask - 1) / kSubjectsPerTask;
+  const auto fit_task = [&](std::size_t task) {
+    const std::size_t end = std::min(count, (task + 1) * kSubjectsPerTask);
+    for (std::size_t i = task * kSubjectsPerTask; i < end; ++i) {
+      RegressionResult<G>& fit = result.fits[i];
+      fit = regression.fit(subjects[i].observations, subjects[i].covariates);
+      if (fit.ok()) result.trends[i] = {(*fit.geodesic)(t0), (*fit.geodesic)(t1)};
+    }
   };
-  if (options.threads > 1 && count > 1) {
-    ChunkPool(options.threads, count).run(count, fit_subject);
+  if (options.threads > 1 && tasks > 1) {
+    ChunkPool(options.threads, tasks).run(tasks, fit_task);
   } else {
-    for (std::size_t i = 0; i < count; ++i)
-      fit_subject(i);
+    for (std::size_t task = 0; task < tasks; ++task)
+      fit_task(task);
   }
   result.status = Status::converged;
   for (std::size_t i = 0; i < count; ++i) {
