@@ -32,6 +32,7 @@
 #include "bireg/statistics/cohorts/two_sample.hpp"
 #include "bireg/statistics/distributions.hpp"
 #include "bireg/statistics/mean.hpp"
+#include "bireg/statistics/scatter.hpp"
 
 namespace bireg {
 
@@ -250,10 +251,7 @@ PopulationTrend<G> population_trend(const Trends& trends, typename G::Scalar t0,
     return result;
   }
   result.mean = *mean.mean;
-  typename Pair::AdMatrix scatter = Pair::AdMatrix::Zero();
-  for (const auto& y : mean.residuals)
-    scatter.noalias() += y * y.transpose();
-  result.covariance = scatter / static_cast<Scalar>(n - 1);
+  result.covariance = scatter_matrix(mean.residuals, {}) / static_cast<Scalar>(n - 1);
   if (!two_sample_detail::log_determinant(result.covariance)) {
     result.message = "the subjects' trends span fewer than " + std::to_string(p) +
                      " directions of G x G: their covariance is singular";

@@ -42,6 +42,7 @@
 #include "bireg/regression/status.hpp"
 #include "bireg/statistics/mean.hpp"
 #include "bireg/statistics/permutation.hpp"
+#include "bireg/statistics/scatter.hpp"
 
 namespace bireg {
 
@@ -176,14 +177,6 @@ std::optional<typename G::Scalar> statistic(TwoSampleStatistic which, std::size_
   return bhattacharyya;
 }
 
-template <class G>
-typename G::AdMatrix scatter(const std::vector<typename G::Tangent>& residuals) {
-  typename G::AdMatrix s = G::AdMatrix::Zero();
-  for (const auto& y : residuals)
-    s.noalias() += y * y.transpose();
-  return s / static_cast<typename G::Scalar>(residuals.size());
-}
-
 // What every split shares: the pooled sample, its mean p, the coordinates
 // z_i = log(p^{-1} e_i) and Newton's Jacobians there, J_i = J_r^{-1}(-z_i)
 // (mean.hpp), computed once.
@@ -266,6 +259,7 @@ struct Split {
 template <class G>
 void evaluate(const Pooled<G>& pooled, const std::size_t* index, std::size_t m, std::size_t n,
               const TwoSampleOptions<typename G::Scalar>& options, Split<G>& split) {
+  using Scalar = typename G::Scalar;
   split.value.reset();
   const auto mean_of = [&](const std::size_t* first, std::size_t count,
                            typename G::Element& mean_out,
@@ -284,8 +278,8 @@ void evaluate(const Pooled<G>& pooled, const std::size_t* index, std::size_t m, 
   }
   split.c = G::log(G::compose(G::inverse(split.mean_a), split.mean_b));
   if (!split.c.allFinite()) return;
-  split.s_a = scatter<G>(split.y_a);
-  split.s_b = scatter<G>(split.y_b);
+  split.s_a = scatter_matrix(split.y_a, {}) / Scalar(m);
+  split.s_b = scatter_matrix(split.y_b, {}) / Scalar(n);
   if (options.variant == TwoSampleVariant::invariant) {
     // Parallel transport from m_B to m_A (docs/cohorts.md).
     const typename G::AdMatrix transport = G::Ad(G::exp(split.c / 2));
