@@ -33,7 +33,6 @@
 #include <cstdio>
 #include <fstream>
 #include <random>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,52 +46,6 @@ namespace {
 
 using SO3 = bireg::SO3d;
 using Vector3 = SO3::Tangent;
-
-struct Columns {
-  std::vector<double> t;
-  std::vector<std::vector<double>> values;
-};
-
-// A numeric CSV (comma-separated, '#' comments): the first column and the rest.
-bool read_csv(const std::string& path, std::size_t columns, Columns& out) {
-  std::ifstream in(path);
-  if (!in) {
-    std::fprintf(stderr, "gyro_demo: cannot open %s\n", path.c_str());
-    return false;
-  }
-  std::string line;
-  std::size_t number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.empty() || line[0] == '#') continue;
-    std::stringstream fields(line);
-    std::string field;
-    std::vector<double> row;
-    while (std::getline(fields, field, ','))
-      row.push_back(std::stod(field));
-    if (row.size() != columns + 1) {
-      std::fprintf(stderr, "gyro_demo: %s:%zu: expected %zu numbers\n", path.c_str(), number,
-                   columns + 1);
-      return false;
-    }
-    out.t.push_back(row[0]);
-    out.values.emplace_back(row.begin() + 1, row.end());
-  }
-  return true;
-}
-
-// The gyroscope linearly interpolated at time t (clamped at the ends).
-Vector3 gyro_at(const Columns& gyro, double t) {
-  const auto upper = std::lower_bound(gyro.t.begin(), gyro.t.end(), t);
-  const std::size_t j = static_cast<std::size_t>(upper - gyro.t.begin());
-  const auto row = [&](std::size_t k) {
-    return Vector3(gyro.values[k][0], gyro.values[k][1], gyro.values[k][2]);
-  };
-  if (j == 0) return row(0);
-  if (j >= gyro.t.size()) return row(gyro.t.size() - 1);
-  const double share = (t - gyro.t[j - 1]) / (gyro.t[j] - gyro.t[j - 1]);
-  return (1 - share) * row(j - 1) + share * row(j);
-}
 
 using bireg::testing::finite_differences;
 using bireg::testing::rms_error;
@@ -189,25 +142,19 @@ std::vector<Vector3> print_row(const std::string& label, double noise,
   return smoothed.velocity;
 }
 
-// The indices of the first sample at or after each k / hz.
-std::vector<std::size_t> subsample(const std::vector<double>& t, double hz) {
-  std::vector<std::size_t> kept;
-  double next = t.front();
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < next - 1e-9) continue;
-    kept.push_back(i);
-    next += 1.0 / hz;
-  }
-  return kept;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string dir = BIREG_DEMO_DATA_DIR;
-  Columns orientation, gyroscope;
-  if (!read_csv(dir + "/xio_imu_orientation.csv", 9, orientation)) return 1;
-  if (!read_csv(dir + "/xio_imu_gyroscope.csv", 3, gyroscope)) return 1;
+  bireg::testing::Recording orientation, gyroscope;
+  for (const std::string& problem :
+       {bireg::testing::read_recording(dir + "/xio_imu_orientation.csv", 9, orientation),
+        bireg::testing::read_recording(dir + "/xio_imu_gyroscope.csv", 3, gyroscope)}) {
+    if (!problem.empty()) {
+      std::fprintf(stderr, "gyro_demo: %s\n", problem.c_str());
+      return 1;
+    }
+  }
   std::vector<SO3::Element> raw;
   std::vector<Vector3> reference;
   for (std::size_t i = 0; i < orientation.t.size(); ++i) {
@@ -215,7 +162,7 @@ int main(int argc, char** argv) {
     SO3::Element r;
     r << m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8];
     raw.push_back(r);
-    reference.push_back(gyro_at(gyroscope, orientation.t[i]));
+    reference.push_back(bireg::testing::rate_at(gyroscope, orientation.t[i]));
   }
   std::printf("x-IMU recording: %zu orientation samples over %.1f s; gyroscope RMS %.3f rad/s\n\n",
               raw.size(), orientation.t.back() - orientation.t.front(),
@@ -229,7 +176,7 @@ int main(int argc, char** argv) {
   std::normal_distribution<double> normal(0.0, 1.0);
   const std::string plot_path = argc > 1 ? argv[1] : "gyro_demo.svg";
   for (const double hz : {128.0, 50.0, 25.0}) {
-    const std::vector<std::size_t> kept = subsample(orientation.t, hz);
+    const std::vector<std::size_t> kept = bireg::testing::subsample(orientation.t, hz);
     for (const double noise : {0.0, 0.005, 0.02}) {
       std::vector<SO3::Element> r;
       std::vector<double> t;

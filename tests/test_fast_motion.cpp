@@ -16,7 +16,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <random>
 #include <sstream>
 #include <string>
@@ -152,46 +151,25 @@ std::string spin_name(double speed) {
 // first sample at or after each k / hz, with the gyroscope linearly
 // interpolated at their times as the truth, and noise added.
 RotationTrack subsampled_xio(double hz, double noise, unsigned seed) {
-  const auto read = [](const std::string& path, std::size_t columns) {
-    std::ifstream in(path);
-    REQUIRE(in);
-    std::vector<std::vector<double>> rows;
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      std::stringstream fields(line);
-      std::string field;
-      std::vector<double> row;
-      while (std::getline(fields, field, ','))
-        row.push_back(std::stod(field));
-      REQUIRE(row.size() == columns);
-      rows.push_back(row);
-    }
-    return rows;
-  };
-  const auto orientation = read(BIREG_EXAMPLE_DATA_DIR "/xio_imu_orientation.csv", 10);
-  const auto gyroscope = read(BIREG_EXAMPLE_DATA_DIR "/xio_imu_gyroscope.csv", 4);
+  motion::Recording orientation, gyroscope;
+  const std::string orientation_problem =
+      motion::read_recording(BIREG_EXAMPLE_DATA_DIR "/xio_imu_orientation.csv", 9, orientation);
+  const std::string gyroscope_problem =
+      motion::read_recording(BIREG_EXAMPLE_DATA_DIR "/xio_imu_gyroscope.csv", 3, gyroscope);
+  INFO(orientation_problem << gyroscope_problem);
+  REQUIRE(orientation_problem.empty());
+  REQUIRE(gyroscope_problem.empty());
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   RotationTrack track;
-  double next = orientation.front()[0];
-  std::size_t g = 1;
-  for (const auto& row : orientation) {
-    const double t = row[0];
-    if (t < next - 1e-9) continue;
-    next += 1.0 / hz;
+  for (const std::size_t i : motion::subsample(orientation.t, hz)) {
+    const std::vector<double>& m = orientation.values[i];
     SO3::Element r;
-    r << row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8], row[9];
+    r << m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8];
     const SO3::Tangent e = bireg::testing::draw_vector<SO3::Tangent>(rng, normal);
     track.f.push_back(SO3::compose(r, SO3::exp(noise * e)));
-    track.t.push_back(t);
-    while (g + 1 < gyroscope.size() && gyroscope[g][0] < t)
-      ++g;
-    const auto& a = gyroscope[g - 1];
-    const auto& b = gyroscope[g];
-    const double share = std::clamp((t - a[0]) / (b[0] - a[0]), 0.0, 1.0);
-    track.velocity.push_back((1 - share) * SO3::Tangent(a[1], a[2], a[3]) +
-                             share * SO3::Tangent(b[1], b[2], b[3]));
+    track.t.push_back(orientation.t[i]);
+    track.velocity.push_back(motion::rate_at(gyroscope, orientation.t[i]));
   }
   return track;
 }

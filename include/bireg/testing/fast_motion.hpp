@@ -14,9 +14,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <random>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -34,6 +38,64 @@ struct RotationTrack {
 };
 
 using AngularRate = std::function<bireg::SO3d::Tangent(double)>;
+
+// A recording in a numeric CSV (comma-separated, '#' comments and blank
+// lines skipped): the first column (time) and the `columns` after it.
+struct Recording {
+  std::vector<double> t;
+  std::vector<std::vector<double>> values;
+};
+
+// Reads `path` into `out`; returns "" or what is wrong ("cannot open
+// PATH", "PATH:LINE: expected N numbers").
+inline std::string read_recording(const std::string& path, std::size_t columns, Recording& out) {
+  std::ifstream in(path);
+  if (!in) return "cannot open " + path;
+  std::string line;
+  std::size_t number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    std::stringstream fields(line);
+    std::string field;
+    std::vector<double> row;
+    while (std::getline(fields, field, ','))
+      row.push_back(std::stod(field));
+    if (row.size() != columns + 1) {
+      return path + ":" + std::to_string(number) + ": expected " + std::to_string(columns + 1) +
+             " numbers";
+    }
+    out.t.push_back(row[0]);
+    out.values.emplace_back(row.begin() + 1, row.end());
+  }
+  return {};
+}
+
+// A rate recording (three columns, rad/s) linearly interpolated at t,
+// clamped at its ends.
+inline bireg::SO3d::Tangent rate_at(const Recording& rate, double t) {
+  const auto upper = std::lower_bound(rate.t.begin(), rate.t.end(), t);
+  const std::size_t j = static_cast<std::size_t>(upper - rate.t.begin());
+  const auto row = [&](std::size_t k) {
+    return bireg::SO3d::Tangent(rate.values[k][0], rate.values[k][1], rate.values[k][2]);
+  };
+  if (j == 0) return row(0);
+  if (j >= rate.t.size()) return row(rate.t.size() - 1);
+  const double share = (t - rate.t[j - 1]) / (rate.t[j] - rate.t[j - 1]);
+  return (1 - share) * row(j - 1) + share * row(j);
+}
+
+// The indices of the first sample at or after each k / hz from the first.
+inline std::vector<std::size_t> subsample(const std::vector<double>& t, double hz) {
+  std::vector<std::size_t> kept;
+  double next = t.front();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < next - 1e-9) continue;
+    kept.push_back(i);
+    next += 1.0 / hz;
+  }
+  return kept;
+}
 
 // Samples of the rotation whose body angular velocity is `rate`, from t = 0
 // to `duration` s at `hz`, with noise `noise` rad per axis (seed fixed).
