@@ -62,7 +62,7 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   bireg::LocalRegressionOptions<double> options;
   options.kernel = bireg::Kernel::gaussian;
   options.standard_errors = false;
-  const std::vector<double> grid = bireg::bandwidth_grid(t, 20, 0.5);
+  const std::vector<double> grid = bireg::auto_bandwidth_grid(t);
   const bireg::BandwidthSelection<double> selection =
       bireg::select_bandwidth<SO3>(r, t, options, grid);
   Smoothed out;

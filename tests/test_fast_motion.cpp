@@ -49,8 +49,8 @@ struct Velocities {
 Velocities auto_velocity(const RotationTrack& track) {
   bireg::LocalRegressionOptions<double> options;
   Velocities out;
-  out.selection = bireg::select_bandwidth<SO3>(track.f, track.t, options,
-                                               bireg::bandwidth_grid(track.t, 20, 0.5));
+  out.selection =
+      bireg::select_bandwidth<SO3>(track.f, track.t, options, bireg::auto_bandwidth_grid(track.t));
   REQUIRE(out.selection.ok());
   options.bandwidth = out.selection.velocity_bandwidth;
   out.estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(track.f, track.t);

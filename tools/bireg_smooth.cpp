@@ -127,13 +127,6 @@ constexpr const char* kHelp =
     "of the pose output, or with KITTI output no poses are written; a failed\n"
     "velocity row says 'failed: <reason>'); 4 output could not be written.\n";
 
-// Bandwidths tried by --bandwidth auto: kAutoGridSize values from
-// kAutoSmallestSpacings median sample spacings to the whole range. Half a
-// spacing is the narrowest useful Gaussian (its window then holds a sample
-// on each side); noise-free or fast recordings need it.
-constexpr int kAutoGridSize = 20;
-constexpr double kAutoSmallestSpacings = 0.5;
-
 // More queries than this from --rate is a typing error, not a request.
 constexpr double kMaxRateQueries = 1e8;
 
@@ -412,8 +405,7 @@ int run(const Command& command) {
     options.bandwidth = *command.bandwidth;
     velocity_bandwidth = options.bandwidth;
   } else {
-    const std::vector<double> grid =
-        bireg::bandwidth_grid(trajectory.covariates, kAutoGridSize, kAutoSmallestSpacings);
+    const std::vector<double> grid = bireg::auto_bandwidth_grid(trajectory.covariates);
     bireg_cli::Progress progress("bireg_smooth", command.progress);
     const bireg::BandwidthSelection<double> selection =
         bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid,

@@ -417,4 +417,17 @@ std::vector<double> bandwidth_grid(const Covariates& covariates, int count = 20,
   return grid;
 }
 
+// The grid of "bandwidth auto" (bireg_smooth, the Python package's
+// LocalRegression): kAutoGridSize values from kAutoSmallestSpacings median
+// sample spacings to the whole range. Half a spacing is the narrowest
+// useful Gaussian (its window then holds a sample on each side);
+// noise-free or fast recordings need it.
+inline constexpr int kAutoGridSize = 20;
+inline constexpr double kAutoSmallestSpacings = 0.5;
+
+template <class Covariates>
+std::vector<double> auto_bandwidth_grid(const Covariates& covariates) {
+  return bandwidth_grid(covariates, kAutoGridSize, kAutoSmallestSpacings);
+}
+
 }  // namespace bireg

@@ -219,9 +219,9 @@ class LocalGeodesicRegression {
     std::vector<Estimate> estimates(queries.size());
     for (std::size_t q = 0; q < queries.size(); ++q)
       estimates[q].covariate = queries[q];
-    if (const std::string refusal = check(observations, covariates, queries); !refusal.empty()) {
+    if (const std::string why = refusal(observations, covariates, queries); !why.empty()) {
       for (Estimate& estimate : estimates)
-        estimate.message = refusal;
+        estimate.message = why;
       return estimates;
     }
 
@@ -284,7 +284,7 @@ class LocalGeodesicRegression {
   HeldOut<G> held_out(const Observations& observations, const Covariates& covariates,
                       HoldOut mode) const {
     HeldOut<G> held;
-    held.problem = check(observations, covariates, {});
+    held.problem = refusal(observations, covariates, {});
     if (!held.problem.empty()) return held;
     const std::size_t n = observations.size();
     std::vector<std::size_t> order;
@@ -350,6 +350,40 @@ class LocalGeodesicRegression {
     return held;
   }
 
+  // Why smooth_at() would refuse these inputs (each of its estimates then
+  // carries this message), or empty: the options, the lengths, the
+  // observations (check_observations) and every covariate and query
+  // finite. Nothing is fitted.
+  template <class Observations, class Covariates>
+  std::string refusal(const Observations& observations, const Covariates& covariates,
+                      const std::vector<Scalar>& queries) const {
+    using std::isfinite;
+    if (!(options_.bandwidth > 0) || !isfinite(options_.bandwidth)) {
+      return "the bandwidth must be a finite positive number";
+    }
+    if (!(options_.max_turn > 0) || !(options_.max_turn <= Scalar(2.5))) {
+      return "max_turn must be in (0, 2.5] radians";
+    }
+    if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
+    if (options_.threads < 1)
+      return "threads must be at least 1, got " + std::to_string(options_.threads);
+    if (auto rejection = validate_options(options_.fit)) return rejection->message;
+    if (observations.size() != covariates.size()) {
+      return "observations and covariates differ in length";
+    }
+    if (auto rejection = check_observations<G>(observations, options_.fit.element_tolerance)) {
+      return rejection->message;
+    }
+    for (std::size_t i = 0; i < covariates.size(); ++i) {
+      if (!isfinite(Scalar(covariates[i])))
+        return "covariate " + std::to_string(i) + " is not finite";
+    }
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+      if (!isfinite(queries[q])) return "query " + std::to_string(q) + " is not finite";
+    }
+    return {};
+  }
+
  private:
   // The observations in ascending covariate order (stable: ties keep their
   // input order), with the permutation that sorts them.
@@ -403,36 +437,6 @@ class LocalGeodesicRegression {
     ForceWorkspace<G> workspace;
     IterationRecord<G> record;
   };
-
-  template <class Observations, class Covariates>
-  std::string check(const Observations& observations, const Covariates& covariates,
-                    const std::vector<Scalar>& queries) const {
-    using std::isfinite;
-    if (!(options_.bandwidth > 0) || !isfinite(options_.bandwidth)) {
-      return "the bandwidth must be a finite positive number";
-    }
-    if (!(options_.max_turn > 0) || !(options_.max_turn <= Scalar(2.5))) {
-      return "max_turn must be in (0, 2.5] radians";
-    }
-    if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
-    if (options_.threads < 1)
-      return "threads must be at least 1, got " + std::to_string(options_.threads);
-    if (auto rejection = validate_options(options_.fit)) return rejection->message;
-    if (observations.size() != covariates.size()) {
-      return "observations and covariates differ in length";
-    }
-    if (auto rejection = check_observations<G>(observations, options_.fit.element_tolerance)) {
-      return rejection->message;
-    }
-    for (std::size_t i = 0; i < covariates.size(); ++i) {
-      if (!isfinite(Scalar(covariates[i])))
-        return "covariate " + std::to_string(i) + " is not finite";
-    }
-    for (std::size_t q = 0; q < queries.size(); ++q) {
-      if (!isfinite(queries[q])) return "query " + std::to_string(q) + " is not finite";
-    }
-    return {};
-  }
 
   // The estimate at tau from its window, into `estimate` (whose vectors
   // and message keep their capacity); `previous` is the last successful

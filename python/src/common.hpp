@@ -1,0 +1,156 @@
+// What every binding file shares: the groups Python can name, the view of a
+// numpy stack of matrices as the library's observations, and the array
+// conversions. No statistics here: the binding files call the library.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
+#include <Eigen/Core>
+
+#include "bireg/groups/matrix_group.hpp"
+#include "bireg/groups/se2.hpp"
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
+#include "bireg/groups/so2.hpp"
+#include "bireg/groups/so3.hpp"
+
+namespace bireg_python {
+
+namespace nb = nanobind;
+
+// Inputs arrive C-contiguous float64 (the Python layer converts once, with
+// numpy, and checks the shapes; see bireg/_arrays.py).
+using Stack = nb::ndarray<const double, nb::ndim<3>, nb::c_contig, nb::device::cpu>;
+using Matrix = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Vector = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using Output = nb::ndarray<nb::numpy, double>;
+
+template <class G>
+struct Tag {
+  using type = G;
+};
+
+// The groups of the Python package, by the names Python uses.
+inline const char* const kGroupNames = "SO2, SO3, SE2, SE3, Sim3, SL3, GLp3";
+
+// Calls f(Tag<G>{}) for the group named `name`; ValueError for another name.
+template <class F>
+decltype(auto) with_group(const std::string& name, F&& f) {
+  if (name == "SO2") return f(Tag<bireg::SO2d>{});
+  if (name == "SO3") return f(Tag<bireg::SO3d>{});
+  if (name == "SE2") return f(Tag<bireg::SE2d>{});
+  if (name == "SE3") return f(Tag<bireg::SE3d>{});
+  if (name == "Sim3") return f(Tag<bireg::Sim3d>{});
+  if (name == "SL3") return f(Tag<bireg::SL3<double>>{});
+  if (name == "GLp3") return f(Tag<bireg::GLp<3, double>>{});
+  throw nb::value_error(("unknown group '" + name + "': expected one of " + kGroupNames).c_str());
+}
+
+template <class G>
+constexpr int side() {
+  return int(G::Element::RowsAtCompileTime);
+}
+
+// A stack of row-major n x n matrices (numpy's (N, n, n) in C order) seen
+// as the library's observations: indexable, with size(); element i is
+// converted to the group's (column-major) Element when it is read, so the
+// data are never copied whole.
+template <class G>
+class StackView {
+ public:
+  using Element = typename G::Element;
+  using RowMajor = Eigen::Matrix<double, side<G>(), side<G>(), Eigen::RowMajor>;
+
+  StackView() = default;
+  StackView(const double* data, std::size_t size) : data_(data), size_(size) {}
+  explicit StackView(const Stack& stack) : data_(stack.data()), size_(stack.shape(0)) {}
+
+  std::size_t size() const { return size_; }
+  Element operator[](std::size_t i) const {
+    return Eigen::Map<const RowMajor>(data_ + i * std::size_t(side<G>() * side<G>()));
+  }
+
+ private:
+  const double* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+inline std::vector<double> to_vector(const Vector& v) {
+  return std::vector<double>(v.data(), v.data() + v.shape(0));
+}
+
+// A new float64 numpy array of the given shape, owned by Python, and its
+// data to fill (before it is handed over; no other reference exists).
+class NewArray {
+ public:
+  explicit NewArray(std::vector<std::size_t> shape) : shape_(std::move(shape)) {
+    std::size_t count = 1;
+    for (std::size_t s : shape_)
+      count *= s;
+    data_ = new double[count > 0 ? count : 1]();
+  }
+  NewArray(const NewArray&) = delete;
+  NewArray& operator=(const NewArray&) = delete;
+  ~NewArray() { delete[] data_; }
+
+  double* data() { return data_; }
+
+  // Hands the buffer to a numpy array (needs the GIL).
+  Output release() {
+    double* data = data_;
+    data_ = nullptr;
+    nb::capsule owner(data, [](void* p) noexcept { delete[] static_cast<double*>(p); });
+    return Output(data, shape_.size(), shape_.data(), owner);
+  }
+
+ private:
+  std::vector<std::size_t> shape_;
+  double* data_ = nullptr;
+};
+
+// Writes an Eigen matrix row-major at `out` (numpy's C order).
+template <class M>
+void write_row_major(const M& m, double* out) {
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
+    for (Eigen::Index c = 0; c < m.cols(); ++c)
+      *out++ = m(r, c);
+}
+
+template <class M>
+Output matrix_array(const M& m) {
+  NewArray a({std::size_t(m.rows()), std::size_t(m.cols())});
+  write_row_major(m, a.data());
+  return a.release();
+}
+
+template <class V>
+Output vector_array(const V& v) {
+  NewArray a({std::size_t(v.size())});
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    a.data()[k] = v[k];
+  return a.release();
+}
+
+// Tangent vectors, one row each: (N, d).
+template <class G>
+Output tangent_rows(const std::vector<typename G::Tangent>& rows) {
+  NewArray a({rows.size(), std::size_t(G::dof)});
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (int k = 0; k < G::dof; ++k)
+      a.data()[i * G::dof + k] = rows[i][k];
+  return a.release();
+}
+
+void bind_groups(nb::module_& m);
+void bind_regression(nb::module_& m);
+void bind_statistics(nb::module_& m);
+void bind_io(nb::module_& m);
+
+}  // namespace bireg_python

@@ -1,0 +1,53 @@
+// A fitted geodesic as Python holds it: the fit's result with the data it
+// was fitted to (kept alive, not copied), so that the statistics layer can
+// compute covariances, bands and tests from it. One class per group behind
+// one base, so that a Python object needs no template.
+#pragma once
+
+#include <initializer_list>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common.hpp"
+
+#include "bireg/regression.hpp"
+
+namespace bireg_python {
+
+struct FitHandle {
+  virtual ~FitHandle() = default;
+  std::string group;
+};
+
+template <class G>
+struct GroupFit final : FitHandle {
+  using Group = G;
+  Stack poses;  // the observations, owned by Python
+  std::vector<double> covariates;
+  std::vector<double> weights;  // empty: all 1
+  bireg::RegressionOptions<double> options;
+  bireg::RegressionResult<G> result;
+
+  StackView<G> observations() const { return StackView<G>(poses); }
+};
+
+// The handle as the group's fit; the group is the handle's own.
+template <class G>
+const GroupFit<G>& as_group_fit(const FitHandle& handle) {
+  return static_cast<const GroupFit<G>&>(handle);
+}
+
+// The enumerator whose to_string is `name`; ValueError naming the choices.
+template <class Enum>
+Enum parse_choice(const std::string& name, std::initializer_list<Enum> choices, const char* what) {
+  std::string known;
+  for (Enum e : choices) {
+    if (name == to_string(e)) return e;
+    known += (known.empty() ? "" : ", ") + std::string(to_string(e));
+  }
+  throw nb::value_error(
+      (std::string("unknown ") + what + " '" + name + "': expected one of " + known).c_str());
+}
+
+}  // namespace bireg_python

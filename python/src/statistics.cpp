@@ -1,0 +1,62 @@
+// The statistics layer: the bi-invariant mean, a fit's covariance,
+// confidence band, explained variance and trend test, and local
+// regression with the automatic bandwidth. Each function calls the
+// library's (statistics_impl.hpp) and converts; the GIL is released while
+// it works.
+#include <cstdint>
+#include <string>
+
+#include "statistics_impl.hpp"
+
+namespace bireg_python {
+
+void bind_statistics(nb::module_& m) {
+  m.def("mean", [](const std::string& group, const Stack& y, const Vector& w, double tolerance,
+                   int max_iterations) {
+    return with_group(group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::mean(y, w, tolerance, max_iterations);
+    });
+  });
+  m.def("covariance", [](const FitHandle& h, const std::string& flavour) {
+    return with_group(h.group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::covariance(h, flavour);
+    });
+  });
+  m.def("confidence_band", [](const FitHandle& h, const Vector& t, double level,
+                              const std::string& flavour) {
+    return with_group(h.group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::confidence_band(h, t, level, flavour);
+    });
+  });
+  m.def("score", [](const FitHandle& h, const Vector& t, const Stack& y) {
+    return with_group(h.group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::score(h, t, y);
+    });
+  });
+  m.def("trend_test", [](const FitHandle& h, int permutations, std::uint64_t seed, int threads) {
+    return with_group(h.group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::trend_test(h, permutations, seed,
+                                                                       threads);
+    });
+  });
+  m.def("smooth",
+        [](const std::string& group, const Vector& t, const Stack& y, const Vector& queries,
+           const std::string& kernel, double bandwidth, double velocity_bandwidth, int threads) {
+          const auto options = statistics_detail::local_options(kernel, bandwidth, threads);
+          if (!(velocity_bandwidth > 0) || !std::isfinite(velocity_bandwidth))
+            statistics_detail::refuse("velocity bandwidth must be a finite positive number");
+          return with_group(group, [&](auto tag) {
+            return GroupStatistics<typename decltype(tag)::type>::smooth(t, y, queries, options,
+                                                                         velocity_bandwidth);
+          });
+        });
+  m.def("select_bandwidth", [](const std::string& group, const Vector& t, const Stack& y,
+                               const std::string& kernel, int threads) {
+    const auto options = statistics_detail::local_options(kernel, 1.0, threads);
+    return with_group(group, [&](auto tag) {
+      return GroupStatistics<typename decltype(tag)::type>::select_bandwidth(t, y, options);
+    });
+  });
+}
+
+}  // namespace bireg_python

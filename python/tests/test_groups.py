@@ -1,0 +1,74 @@
+"""The batched group functions: against a per-element loop, against
+scipy's rotations, the group laws at rounding, broadcasting, and their
+refusals."""
+
+import numpy as np
+import pytest
+
+import bireg
+from conftest import GROUP_NAMES
+
+
+@pytest.mark.parametrize("name", GROUP_NAMES)
+def test_batch_equals_loop_and_laws_hold(name, rng):
+    g = bireg.groups.get(name)
+    x = 0.5 * rng.standard_normal((4, 5, g.dim))
+    e = g.exp(x)
+    assert e.shape == (4, 5, g.matrix_size, g.matrix_size)
+    for i in range(4):
+        for j in range(5):
+            np.testing.assert_array_equal(e[i, j], g.exp(x[i, j]))
+    # log(exp(x)) = x inside the domain; exp(x) exp(-x) = 1; Ad(exp x) x = x.
+    np.testing.assert_allclose(g.log(e), x, atol=1e-12)
+    eye = np.broadcast_to(np.eye(g.matrix_size), e.shape)
+    np.testing.assert_allclose(g.compose(e, g.exp(-x)), eye, atol=1e-12)
+    np.testing.assert_allclose(g.compose(e, g.inverse(e)), eye, atol=1e-12)
+    ad = g.Ad(e)
+    np.testing.assert_allclose(np.einsum("...ij,...j->...i", ad, x), x, atol=1e-12)
+    assert g.is_element(e).all()
+    # J_r(x) at x = 0 is the identity; d/ds exp(x + s v) at 0 is exp(x) J_r(x) v.
+    np.testing.assert_allclose(g.right_jacobian(np.zeros(g.dim)), np.eye(g.dim), atol=1e-15)
+
+
+@pytest.mark.parametrize("name", GROUP_NAMES)
+def test_compose_broadcasts(name, rng):
+    g = bireg.groups.get(name)
+    a = g.exp(0.4 * rng.standard_normal((3, 1, g.dim)))
+    b = g.exp(0.4 * rng.standard_normal((1, 6, g.dim)))
+    c = g.compose(a, b)
+    assert c.shape == (3, 6, g.matrix_size, g.matrix_size)
+    np.testing.assert_allclose(c[2, 4], a[2, 0] @ b[0, 4], rtol=0, atol=1e-14)
+
+
+def test_so3_agrees_with_scipy(rng):
+    Rotation = pytest.importorskip("scipy.spatial.transform").Rotation
+    x = rng.uniform(-1.0, 1.0, (1000, 3)) * 1.7
+    np.testing.assert_allclose(bireg.SO3.exp(x), Rotation.from_rotvec(x).as_matrix(), atol=1e-12)
+    r = Rotation.from_rotvec(x).as_matrix()
+    np.testing.assert_allclose(bireg.SO3.log(r), Rotation.from_matrix(r).as_rotvec(), atol=1e-12)
+
+
+def test_float32_and_non_contiguous_inputs_are_converted(rng):
+    x = 0.3 * rng.standard_normal((10, 6))
+    expected = bireg.SE3.exp(x)
+    np.testing.assert_allclose(bireg.SE3.exp(x.astype(np.float32)), expected, atol=1e-6)
+    strided = np.asfortranarray(expected)
+    np.testing.assert_array_equal(bireg.SE3.log(strided), bireg.SE3.log(expected))
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: bireg.SE3.exp(np.zeros(5)), r"shape \(\.\.\., 6\)"),
+        (lambda: bireg.SE3.log(np.eye(3)), r"shape \(\.\.\., 4, 4\)"),
+        (lambda: bireg.SO3.exp(np.array([[0.0, np.nan, 0.0]])), "not finite at index 0"),
+        (lambda: bireg.SO3.log(np.stack([np.eye(3), np.zeros((3, 3))])),
+         "no principal logarithm.*index 1"),
+        (lambda: bireg.GLp3.inverse(np.stack([np.eye(3), -np.eye(3)])), "not an element.*index 1"),
+        (lambda: bireg.SE3.is_element(np.eye(4), tol=-1), "tol"),
+        (lambda: bireg.groups.get("SO4"), "unknown group 'SO4'"),
+    ],
+)
+def test_refusals_are_value_errors(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
