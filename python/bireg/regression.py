@@ -28,16 +28,22 @@ class GeodesicRegression:
     gauss_newton, preconditioned, optimal_linear, paper; ``method`` exact or
     series_adaptive; ``tol`` the step norm at convergence; ``max_iter``;
     ``threads`` for the force's chunks (results do not depend on it).
+    ``loss`` None, or huber, cauchy or tukey for a robust fit
+    (``bireg::RobustGeodesicRegression``) with constant ``loss_scale`` in
+    Mahalanobis units (0: 95 % Gaussian efficiency); its weights and
+    outliers are in ``robust_``.
     """
 
     def __init__(self, group="SE3", solver="gauss_newton", method="exact", tol=1e-10,
-                 max_iter=1000, threads=1):
+                 max_iter=1000, threads=1, loss=None, loss_scale=0.0):
         self.group = group
         self.solver = solver
         self.method = method
         self.tol = tol
         self.max_iter = max_iter
         self.threads = threads
+        self.loss = loss
+        self.loss_scale = loss_scale
 
     def fit(self, t, Y, sample_weight=None):
         """Fits the geodesic to Y[i] at t[i]; returns self.
@@ -54,8 +60,11 @@ class GeodesicRegression:
         w = _arrays.weights(sample_weight, t.shape[0])
         self._fit = _bireg.fit(group.name, t, Y, w, self.solver, self.method, float(self.tol),
                                _arrays.positive_int(self.max_iter, "max_iter"),
-                               _arrays.positive_int(self.threads, "threads"))
+                               _arrays.positive_int(self.threads, "threads"),
+                               "none" if self.loss is None else str(self.loss),
+                               float(self.loss_scale))
         fit = self._fit
+        self.robust_ = fit.robust if self.loss is not None else None
         self.status_ = fit.status
         self.n_iter_ = fit.iterations
         self.diagnostics_ = fit.diagnostics
@@ -72,6 +81,9 @@ class GeodesicRegression:
         if self.status_ not in _SUCCESS:
             warnings.warn(f"the fit stopped with status {self.status_} after {self.n_iter_} "
                           "iterations", ConvergenceWarning, stacklevel=2)
+        elif self.robust_ is not None and self.robust_["status"] != "converged":
+            warnings.warn(f"the robust reweighting stopped with status {self.robust_['status']}: "
+                          f"{self.robust_['message']}", ConvergenceWarning, stacklevel=2)
         return self
 
     def _fitted(self):

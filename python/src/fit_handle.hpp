@@ -5,6 +5,7 @@
 #pragma once
 
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "common.hpp"
 
 #include "bireg/regression.hpp"
+#include "bireg/statistics/robust.hpp"
 
 namespace bireg_python {
 
@@ -28,6 +30,9 @@ struct GroupFit final : FitHandle {
   std::vector<double> weights;  // empty: all 1
   bireg::RegressionOptions<double> options;
   bireg::RegressionResult<G> result;
+  // Set for a robust fit (RobustGeodesicRegression): `result` is its last
+  // fit, whose weights are the robust weights times `weights`.
+  std::optional<bireg::RobustResult<G>> robust;
 
   StackView<G> observations() const { return StackView<G>(poses); }
 };

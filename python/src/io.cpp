@@ -58,22 +58,27 @@ nb::dict read(const std::string& path, const std::optional<bireg::io::Format>& f
 }  // namespace
 
 void bind_io(nb::module_& m) {
-  m.def("read_trajectory", [](const std::string& path, const std::string& group,
-                              const std::string& format, bool project) {
-    std::optional<bireg::io::Format> chosen;
-    if (!format.empty()) {
-      chosen = bireg::io::format_from_string(format);
-      if (!chosen)
-        throw nb::value_error(
-            ("unknown format '" + format + "': expected one of matrix, tum, euroc, kitti").c_str());
-    }
-    return with_group(group, [&](auto tag) -> nb::dict {
-      using G = typename decltype(tag)::type;
-      if (chosen && !bireg::io::reads<G>(*chosen))
-        throw nb::value_error(bireg::io::unsupported_format_message<G>(*chosen).c_str());
-      return read<G>(path, chosen, project);
-    });
-  });
+  m.def(
+      "read_trajectory",
+      [](const std::string& path, const std::string& group, const std::string& format,
+         bool project) {
+        std::optional<bireg::io::Format> chosen;
+        if (!format.empty()) {
+          chosen = bireg::io::format_from_string(format);
+          if (!chosen)
+            throw nb::value_error(
+                ("unknown format '" + format + "': expected one of matrix, tum, euroc, kitti")
+                    .c_str());
+        }
+        return with_group(group, [&](auto tag) -> nb::dict {
+          using G = typename decltype(tag)::type;
+          if (chosen && !bireg::io::reads<G>(*chosen))
+            throw nb::value_error(bireg::io::unsupported_format_message<G>(*chosen).c_str());
+          return read<G>(path, chosen, project);
+        });
+      },
+      nb::arg("path"), nb::arg("group"), nb::arg("format"), nb::arg("project"),
+      "bireg::io::read_trajectory<G>: t, Y, timestamps, lines, format.");
 }
 
 }  // namespace bireg_python

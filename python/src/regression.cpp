@@ -1,8 +1,10 @@
 // The regression layer: fit() and what a fitted geodesic tells by itself
 // (its endpoints, velocities, poses at new covariates, residuals and
 // diagnostics). The GIL is released while the library works.
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nanobind/stl/pair.h>
@@ -38,10 +40,24 @@ bireg::RegressionOptions<double> regression_options(const std::string& solver,
   throw nb::value_error(message.c_str());
 }
 
+// The robust options, or none for loss "none".
+std::optional<bireg::RobustOptions<double>> robust_options(const std::string& loss,
+                                                           double loss_scale) {
+  if (loss == "none") return std::nullopt;
+  bireg::RobustOptions<double> options;
+  options.loss = parse_choice(loss, {bireg::Loss::huber, bireg::Loss::cauchy, bireg::Loss::tukey},
+                              "loss (or none)");
+  if (!(loss_scale >= 0) || !std::isfinite(loss_scale))
+    refuse("loss_scale must be a finite non-negative number (0: 95% efficiency)");
+  options.loss_scale = loss_scale;
+  return options;
+}
+
 template <class G>
 std::unique_ptr<FitHandle> fit_group(const std::string& group, const Vector& t, const Stack& y,
                                      const Vector& w,
-                                     const bireg::RegressionOptions<double>& options) {
+                                     const bireg::RegressionOptions<double>& options,
+                                     const std::optional<bireg::RobustOptions<double>>& robust) {
   auto fit = std::make_unique<GroupFit<G>>();
   fit->group = group;
   fit->poses = y;
@@ -50,11 +66,41 @@ std::unique_ptr<FitHandle> fit_group(const std::string& group, const Vector& t, 
   fit->options = options;
   {
     nb::gil_scoped_release release;
-    fit->result = bireg::GeodesicRegression<G>(options).fit(fit->observations(), fit->covariates,
-                                                            fit->weights);
+    if (robust) {
+      fit->robust = bireg::RobustGeodesicRegression<G>(*robust, options)
+                        .fit(fit->observations(), fit->covariates, fit->weights);
+      fit->result = fit->robust->fit;
+    } else {
+      fit->result = bireg::GeodesicRegression<G>(options).fit(fit->observations(), fit->covariates,
+                                                              fit->weights);
+    }
   }
   if (fit->result.status == bireg::Status::invalid_input) refuse(fit->result.message);
+  if (fit->robust && fit->robust->status == bireg::RobustStatus::invalid_input)
+    refuse(fit->robust->message);
   return fit;
+}
+
+template <class G>
+nb::dict robust_report(const GroupFit<G>& fit) {
+  nb::dict out;
+  if (!fit.robust) return out;
+  const bireg::RobustResult<G>& r = *fit.robust;
+  out["status"] = std::string(to_string(r.status));
+  out["message"] = r.message;
+  out["loss"] = std::string(to_string(r.loss));
+  out["loss_scale"] = r.loss_scale;
+  out["rounds"] = r.rounds;
+  NewArray weights({r.robust_weights.size()}), distances({r.distances.size()});
+  std::copy(r.robust_weights.begin(), r.robust_weights.end(), weights.data());
+  std::copy(r.distances.begin(), r.distances.end(), distances.data());
+  out["weights"] = weights.release();
+  out["distances"] = distances.release();
+  nb::list outliers;
+  for (std::size_t i : r.outliers)
+    outliers.append(i);
+  out["outliers"] = outliers;
+  return out;
 }
 
 // The geodesic if the fit left a finite one (a diverged fit may not).
@@ -211,28 +257,43 @@ void bind_regression(nb::module_& m) {
                    [](const FitHandle& h) {
                      return on_fit(h, [](const auto& f) { return diagnostics(f); });
                    })
-      .def("predict",
-           [](const FitHandle& h, const Vector& t) {
-             return on_fit(h, [&](const auto& f) { return predict(f, t); });
-           })
-      .def("spatial_velocity", [](const FitHandle& h, const Vector& t) {
-        return on_fit(h, [&](const auto& f) { return spatial_velocity(f, t); });
-      });
+      .def_prop_ro(
+          "robust",
+          [](const FitHandle& h) {
+            return on_fit(h, [](const auto& f) { return robust_report(f); });
+          },
+          "A robust fit's status, weights, distances and outliers (empty otherwise).")
+      .def(
+          "predict",
+          [](const FitHandle& h, const Vector& t) {
+            return on_fit(h, [&](const auto& f) { return predict(f, t); });
+          },
+          nb::arg("t"), "The fitted geodesic at each covariate: (M,) -> (M, n, n).")
+      .def(
+          "spatial_velocity",
+          [](const FitHandle& h, const Vector& t) {
+            return on_fit(h, [&](const auto& f) { return spatial_velocity(f, t); });
+          },
+          nb::arg("t"), "Ad_gamma(t) of the body velocity at each covariate: (M,) -> (M, d).");
 
   m.def(
       "fit",
       [](const std::string& group, const Vector& t, const Stack& y, const Vector& w,
          const std::string& solver, const std::string& method, double tolerance, int max_iterations,
-         int threads) {
+         int threads, const std::string& loss, double loss_scale) {
         const bireg::RegressionOptions<double> options =
             regression_options(solver, method, tolerance, max_iterations, threads);
+        const auto robust = robust_options(loss, loss_scale);
         return with_group(group, [&](auto tag) {
           using G = typename decltype(tag)::type;
-          return fit_group<G>(group, t, y, w, options);
+          return fit_group<G>(group, t, y, w, options, robust);
         });
       },
       nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("weights"), nb::arg("solver"),
-      nb::arg("method"), nb::arg("tol"), nb::arg("max_iter"), nb::arg("threads"));
+      nb::arg("method"), nb::arg("tol"), nb::arg("max_iter"), nb::arg("threads"), nb::arg("loss"),
+      nb::arg("loss_scale"),
+      "bireg::GeodesicRegression<G>::fit (or RobustGeodesicRegression with a loss) of y at t "
+      "with weights (empty: all 1). ValueError for invalid input.");
 }
 
 }  // namespace bireg_python

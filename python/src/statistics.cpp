@@ -11,52 +11,82 @@
 namespace bireg_python {
 
 void bind_statistics(nb::module_& m) {
-  m.def("mean", [](const std::string& group, const Stack& y, const Vector& w, double tolerance,
-                   int max_iterations) {
-    return with_group(group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::mean(y, w, tolerance, max_iterations);
-    });
-  });
-  m.def("covariance", [](const FitHandle& h, const std::string& flavour) {
-    return with_group(h.group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::covariance(h, flavour);
-    });
-  });
-  m.def("confidence_band", [](const FitHandle& h, const Vector& t, double level,
-                              const std::string& flavour) {
-    return with_group(h.group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::confidence_band(h, t, level, flavour);
-    });
-  });
-  m.def("score", [](const FitHandle& h, const Vector& t, const Stack& y) {
-    return with_group(h.group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::score(h, t, y);
-    });
-  });
-  m.def("trend_test", [](const FitHandle& h, int permutations, std::uint64_t seed, int threads) {
-    return with_group(h.group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::trend_test(h, permutations, seed,
-                                                                       threads);
-    });
-  });
-  m.def("smooth",
-        [](const std::string& group, const Vector& t, const Stack& y, const Vector& queries,
-           const std::string& kernel, double bandwidth, double velocity_bandwidth, int threads) {
-          const auto options = statistics_detail::local_options(kernel, bandwidth, threads);
-          if (!(velocity_bandwidth > 0) || !std::isfinite(velocity_bandwidth))
-            statistics_detail::refuse("velocity bandwidth must be a finite positive number");
-          return with_group(group, [&](auto tag) {
-            return GroupStatistics<typename decltype(tag)::type>::smooth(t, y, queries, options,
-                                                                         velocity_bandwidth);
-          });
+  m.def(
+      "mean",
+      [](const std::string& group, const Stack& y, const Vector& w, double tolerance,
+         int max_iterations) {
+        return with_group(group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::mean(y, w, tolerance,
+                                                                     max_iterations);
         });
-  m.def("select_bandwidth", [](const std::string& group, const Vector& t, const Stack& y,
-                               const std::string& kernel, int threads) {
-    const auto options = statistics_detail::local_options(kernel, 1.0, threads);
-    return with_group(group, [&](auto tag) {
-      return GroupStatistics<typename decltype(tag)::type>::select_bandwidth(t, y, options);
-    });
-  });
+      },
+      nb::arg("group"), nb::arg("y"), nb::arg("weights"), nb::arg("tol"), nb::arg("max_iter"),
+      "bireg::mean<G>: a dict with the mean, status, iterations, residuals.");
+  m.def(
+      "covariance",
+      [](const FitHandle& h, const std::string& flavour) {
+        return with_group(h.group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::covariance(h, flavour);
+        });
+      },
+      nb::arg("fit"), nb::arg("flavour"),
+      "bireg::covariance of a fit: endpoint, velocity and residual covariances.");
+  m.def(
+      "confidence_band",
+      [](const FitHandle& h, const Vector& t, double level, const std::string& flavour) {
+        return with_group(h.group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::confidence_band(h, t, level,
+                                                                                flavour);
+        });
+      },
+      nb::arg("fit"), nb::arg("t"), nb::arg("level"), nb::arg("flavour"),
+      "Half-widths of the pose's confidence region per covariate: (M,) -> (M, d).");
+  m.def(
+      "score",
+      [](const FitHandle& h, const Vector& t, const Stack& y) {
+        return with_group(h.group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::score(h, t, y);
+        });
+      },
+      nb::arg("fit"), nb::arg("t"), nb::arg("y"),
+      "The generalised explained variance of the fitted geodesic on (t, y).");
+  m.def(
+      "trend_test",
+      [](const FitHandle& h, int permutations, std::uint64_t seed, int threads) {
+        return with_group(h.group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::trend_test(h, permutations, seed,
+                                                                           threads);
+        });
+      },
+      nb::arg("fit"), nb::arg("permutations"), nb::arg("seed"), nb::arg("threads"),
+      "bireg::trend_test with the fit's options: statistic and p_value.");
+  m.def(
+      "smooth",
+      [](const std::string& group, const Vector& t, const Stack& y, const Vector& queries,
+         const std::string& kernel, double bandwidth, double velocity_bandwidth, int threads) {
+        const auto options = statistics_detail::local_options(kernel, bandwidth, threads);
+        if (!(velocity_bandwidth > 0) || !std::isfinite(velocity_bandwidth))
+          statistics_detail::refuse("velocity bandwidth must be a finite positive number");
+        return with_group(group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::smooth(t, y, queries, options,
+                                                                       velocity_bandwidth);
+        });
+      },
+      nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("queries"), nb::arg("kernel"),
+      nb::arg("bandwidth"), nb::arg("velocity_bandwidth"), nb::arg("threads"),
+      "LocalGeodesicRegression<G>::smooth_at: pose, velocity, standard errors, status per query.");
+  m.def(
+      "select_bandwidth",
+      [](const std::string& group, const Vector& t, const Stack& y, const std::string& kernel,
+         int threads) {
+        const auto options = statistics_detail::local_options(kernel, 1.0, threads);
+        return with_group(group, [&](auto tag) {
+          return GroupStatistics<typename decltype(tag)::type>::select_bandwidth(t, y, options);
+        });
+      },
+      nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("kernel"), nb::arg("threads"),
+      "bireg::select_bandwidth over auto_bandwidth_grid: the pose's and the velocity's "
+      "bandwidths.");
 }
 
 }  // namespace bireg_python

@@ -47,6 +47,18 @@ nb::dict mean_of(const Stack& y, const Vector& w, double tolerance, int max_iter
   return out;
 }
 
+// The weights of the fit's last solve: a robust fit's robust weights times
+// the user's (the plug-in bireg_fit --loss --confidence uses), else the
+// user's.
+template <class G>
+std::vector<double> statistics_weights(const GroupFit<G>& fit) {
+  if (!fit.robust) return fit.weights;
+  std::vector<double> w = fit.robust->robust_weights;
+  for (std::size_t i = 0; i < fit.weights.size() && i < w.size(); ++i)
+    w[i] *= fit.weights[i];
+  return w;
+}
+
 inline bireg::CovarianceFlavour flavour_of(const std::string& name) {
   return parse_choice(name,
                       {bireg::CovarianceFlavour::homoscedastic, bireg::CovarianceFlavour::robust},
@@ -58,7 +70,7 @@ bireg::FitCovariance<G> covariance_of(const GroupFit<G>& fit, bireg::CovarianceF
   bireg::FitCovariance<G> c;
   {
     nb::gil_scoped_release release;
-    c = bireg::covariance(fit.result, fit.covariates, fit.weights, flavour);
+    c = bireg::covariance(fit.result, fit.covariates, statistics_weights(fit), flavour);
   }
   if (!c.defined()) refuse("covariance: " + c.message);
   return c;
@@ -134,6 +146,10 @@ double score(const GroupFit<G>& fit, const Vector& t, const Stack& y) {
 
 template <class G>
 nb::dict trend_test(const GroupFit<G>& fit, int permutations, std::uint64_t seed, int threads) {
+  if (fit.robust)
+    refuse(
+        "trend_test: not available for a robust fit (the permuted fits would need the "
+        "robust reweighting); fit without loss=");
   bireg::TrendTestOptions options;
   options.permutations = permutations;
   options.seed = seed;

@@ -182,3 +182,39 @@ def test_version_matches_the_cpp_header():
     from conftest import ROOT
     cmake = (ROOT / "CMakeLists.txt").read_text()
     assert bireg.__version__ == re.search(r"project\(bireg\s+VERSION\s+([0-9.]+)", cmake).group(1)
+
+
+@pytest.mark.parametrize("loss", ["huber", "tukey"])
+def test_robust_fit_equals_bireg_fit_and_flags_the_outlier(loss, rng, tmp_path):
+    t, Y = geodesic_data("SE3", 40, rng, noise=0.02)
+    Y[17] = Y[17] @ bireg.SE3.exp([0.5, -0.4, 0.3, 0.9, 0.6, -0.8])  # one gross outlier
+    path = tmp_path / "outlier.csv"
+    write_matrix_file(path, t, Y)
+    tool = bireg_fit_path()
+    if tool is None:
+        pytest.skip("bireg_fit is not built (set BIREG_FIT or build build/tools)")
+    out = subprocess.run([str(tool), "--group", "SE3", "--loss", loss, "--threads", "1",
+                          str(path)], capture_output=True, text=True, check=True)
+    expected = json.loads(out.stdout)
+    reg = bireg.GeodesicRegression(group="SE3", loss=loss).fit(t, Y)
+    np.testing.assert_allclose(reg.g0_, expected["g0"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(reg.g1_, expected["g1"], rtol=0, atol=1e-12)
+    assert reg.robust_["loss_scale"] == pytest.approx(expected["robust"]["loss_scale"], rel=1e-15)
+    # The file's line i + 1 holds observation i.
+    assert [i + 1 for i in reg.robust_["outliers"]] == expected["robust"]["outlier_lines"]
+    assert 17 in reg.robust_["outliers"]
+    assert reg.robust_["weights"][17] < 0.5
+    # Its covariance uses the robust weights (bireg_fit's plug-in); the
+    # trend test of a robust fit is refused rather than computed wrongly.
+    assert reg.covariance("robust")["velocity"].shape == (6, 6)
+    with pytest.raises(ValueError, match="robust fit"):
+        reg.trend_test(permutations=9)
+
+
+def test_robust_refusals():
+    t = np.arange(4.0)
+    Y = bireg.SE3.exp(0.1 * np.arange(24.0).reshape(4, 6))
+    with pytest.raises(ValueError, match="unknown loss"):
+        bireg.GeodesicRegression(loss="l1").fit(t, Y)
+    with pytest.raises(ValueError, match="loss_scale"):
+        bireg.GeodesicRegression(loss="huber", loss_scale=-1.0).fit(t, Y)

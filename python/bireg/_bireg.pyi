@@ -1,0 +1,119 @@
+"""bireg's compiled core: bi-invariant regression on Lie groups"""
+
+from typing import Annotated
+
+import numpy
+from numpy.typing import NDArray
+
+
+def group_info(group: str) -> tuple[int, int]:
+    """The group's (algebra dimension, matrix size)."""
+
+def group_exp(group: str, x: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """exp of each row of x: (M, d) -> (M, n, n)."""
+
+def group_log(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """The principal log of each element: (M, n, n) -> (M, d)."""
+
+def group_compose(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """a[i] b[i]: (M, n, n) twice -> (M, n, n)."""
+
+def group_inverse(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """The inverse of each element."""
+
+def group_Ad(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """The adjoint matrix of each element: (M, n, n) -> (M, d, d)."""
+
+def group_right_jacobian(group: str, x: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+    """J_r(x) of each row of x: (M, d) -> (M, d, d)."""
+
+def group_is_element(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], tol: float) -> NDArray[numpy.bool_]:
+    """Whether each matrix is an element to tol: (M, n, n) -> (M,)."""
+
+class FitHandle:
+    """A geodesic fitted by bireg::GeodesicRegression, with its data."""
+
+    @property
+    def group(self) -> str: ...
+
+    @property
+    def status(self) -> str: ...
+
+    @property
+    def ok(self) -> bool: ...
+
+    @property
+    def iterations(self) -> int: ...
+
+    @property
+    def has_geodesic(self) -> bool: ...
+
+    @property
+    def interval(self) -> tuple[float, float]: ...
+
+    @property
+    def g0(self) -> NDArray[numpy.float64]: ...
+
+    @property
+    def g1(self) -> NDArray[numpy.float64]: ...
+
+    @property
+    def body_velocity(self) -> NDArray[numpy.float64]: ...
+
+    @property
+    def residuals(self) -> NDArray[numpy.float64]: ...
+
+    @property
+    def step_norms(self) -> NDArray[numpy.float64]: ...
+
+    @property
+    def diagnostics(self) -> dict: ...
+
+    @property
+    def robust(self) -> dict:
+        """
+        A robust fit's status, weights, distances and outliers (empty otherwise).
+        """
+
+    def predict(self, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+        """The fitted geodesic at each covariate: (M,) -> (M, n, n)."""
+
+    def spatial_velocity(self, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
+        """Ad_gamma(t) of the body velocity at each covariate: (M,) -> (M, d)."""
+
+def fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], solver: str, method: str, tol: float, max_iter: int, threads: int, loss: str, loss_scale: float) -> FitHandle:
+    """
+    bireg::GeodesicRegression<G>::fit (or RobustGeodesicRegression with a loss) of y at t with weights (empty: all 1). ValueError for invalid input.
+    """
+
+def mean(group: str, y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], tol: float, max_iter: int) -> dict:
+    """bireg::mean<G>: a dict with the mean, status, iterations, residuals."""
+
+def covariance(fit: FitHandle, flavour: str) -> dict:
+    """
+    bireg::covariance of a fit: endpoint, velocity and residual covariances.
+    """
+
+def confidence_band(fit: FitHandle, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], level: float, flavour: str) -> NDArray[numpy.float64]:
+    """
+    Half-widths of the pose's confidence region per covariate: (M,) -> (M, d).
+    """
+
+def score(fit: FitHandle, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> float:
+    """The generalised explained variance of the fitted geodesic on (t, y)."""
+
+def trend_test(fit: FitHandle, permutations: int, seed: int, threads: int) -> dict:
+    """bireg::trend_test with the fit's options: statistic and p_value."""
+
+def smooth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], queries: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], kernel: str, bandwidth: float, velocity_bandwidth: float, threads: int) -> dict:
+    """
+    LocalGeodesicRegression<G>::smooth_at: pose, velocity, standard errors, status per query.
+    """
+
+def select_bandwidth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], kernel: str, threads: int) -> dict:
+    """
+    bireg::select_bandwidth over auto_bandwidth_grid: the pose's and the velocity's bandwidths.
+    """
+
+def read_trajectory(path: str, group: str, format: str, project: bool) -> dict:
+    """bireg::io::read_trajectory<G>: t, Y, timestamps, lines, format."""
