@@ -94,7 +94,10 @@ class NewArray {
     std::size_t count = 1;
     for (std::size_t s : shape_)
       count *= s;
-    data_ = new double[count > 0 ? count : 1]();
+    // Not value-initialised: every caller writes each entry before release()
+    // (a refusal deletes the array instead), and zeroing a 128 MB result
+    // would be a second pass over fresh pages.
+    data_ = new double[count > 0 ? count : 1];
   }
   NewArray(const NewArray&) = delete;
   NewArray& operator=(const NewArray&) = delete;
