@@ -3,6 +3,7 @@
 // conversions. No statistics here: the binding files call the library.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <utility>
@@ -81,6 +82,20 @@ class StackView {
   const double* data_ = nullptr;
   std::size_t size_ = 0;
 };
+
+// A refusal as Python's ValueError, carrying the library's message (which
+// names the observation where there is one).
+[[noreturn]] inline void refuse(const std::string& message) {
+  throw nb::value_error(message.c_str());
+}
+
+// Refuses the first covariate of t that is not finite, naming `what` and
+// its index.
+inline void check_covariates(const Vector& t, const char* what) {
+  for (std::size_t i = 0; i < t.shape(0); ++i)
+    if (!std::isfinite(t.data()[i]))
+      refuse(std::string(what) + ": covariate " + std::to_string(i) + " is not finite");
+}
 
 inline std::vector<double> to_vector(const Vector& v) {
   return std::vector<double>(v.data(), v.data() + v.shape(0));

@@ -24,7 +24,7 @@ inline std::ptrdiff_t first_non_finite(const double* data, std::size_t count, st
   return -1;
 }
 
-[[noreturn]] void refuse(const std::string& what, std::ptrdiff_t index) {
+[[noreturn]] void refuse_at(const std::string& what, std::ptrdiff_t index) {
   throw nb::value_error((what + " " + std::to_string(index)).c_str());
 }
 
@@ -41,7 +41,7 @@ Output map_tangents(const Matrix& x, std::size_t rows, std::size_t cols, const c
     for (std::size_t i = 0; i < count && bad < 0; ++i)
       write_row_major(f(TangentMap<G>(x.data() + i * d)), out.data() + i * rows * cols);
   }
-  if (bad >= 0) refuse(std::string(what) + ": the tangent vector is not finite at index", bad);
+  if (bad >= 0) refuse_at(std::string(what) + ": the tangent vector is not finite at index", bad);
   return out.release();
 }
 
@@ -71,7 +71,7 @@ Output map_elements(const Stack& g, std::vector<std::size_t> shape, const std::s
       write_row_major(value, out.data() + i * stride);
     }
   }
-  if (bad >= 0) refuse(refusal, bad);
+  if (bad >= 0) refuse_at(refusal, bad);
   return out.release();
 }
 
@@ -126,7 +126,7 @@ Output compose_batch(const Stack& a, const Stack& b) {
       write_row_major(c, out.data() + i * n * n);
     }
   }
-  if (bad >= 0) refuse("compose: the product is not finite at index", bad);
+  if (bad >= 0) refuse_at("compose: the product is not finite at index", bad);
   return out.release();
 }
 

@@ -34,12 +34,6 @@ bireg::RegressionOptions<double> regression_options(const std::string& solver,
   return options;
 }
 
-// A refusal as Python's ValueError: the library's message, which names the
-// observation where there is one.
-[[noreturn]] void refuse(const std::string& message) {
-  throw nb::value_error(message.c_str());
-}
-
 // The robust options, or none for loss "none".
 std::optional<bireg::RobustOptions<double>> robust_options(const std::string& loss,
                                                            double loss_scale) {
@@ -124,10 +118,8 @@ const bireg::Geodesic<G>& geodesic_or_refuse(const GroupFit<G>& fit, const char*
 template <class G>
 Output predict(const GroupFit<G>& fit, const Vector& t) {
   const bireg::Geodesic<G>& geodesic = geodesic_or_refuse(fit, "predict");
+  check_covariates(t, "predict");
   const std::size_t count = t.shape(0), n = std::size_t(side<G>());
-  for (std::size_t i = 0; i < count; ++i)
-    if (!std::isfinite(t.data()[i]))
-      refuse("predict: covariate " + std::to_string(i) + " is not finite");
   NewArray out({count, n, n});
   {
     nb::gil_scoped_release release;
@@ -140,12 +132,10 @@ Output predict(const GroupFit<G>& fit, const Vector& t) {
 template <class G>
 Output spatial_velocity(const GroupFit<G>& fit, const Vector& t) {
   const bireg::Geodesic<G>& geodesic = geodesic_or_refuse(fit, "spatial_velocity");
+  check_covariates(t, "spatial_velocity");
   std::vector<typename G::Tangent> rows(t.shape(0));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!std::isfinite(t.data()[i]))
-      refuse("spatial_velocity: covariate " + std::to_string(i) + " is not finite");
+  for (std::size_t i = 0; i < rows.size(); ++i)
     rows[i] = geodesic.spatial_velocity(t.data()[i]);
-  }
   return tangent_rows<G>(rows);
 }
 

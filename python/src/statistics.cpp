@@ -66,7 +66,7 @@ void bind_statistics(nb::module_& m) {
          const std::string& kernel, double bandwidth, double velocity_bandwidth, int threads) {
         const auto options = statistics_detail::local_options(kernel, bandwidth, threads);
         if (!(velocity_bandwidth > 0) || !std::isfinite(velocity_bandwidth))
-          statistics_detail::refuse("velocity bandwidth must be a finite positive number");
+          refuse("velocity bandwidth must be a finite positive number");
         return with_group(group, [&](auto tag) {
           return GroupStatistics<typename decltype(tag)::type>::smooth(t, y, queries, options,
                                                                        velocity_bandwidth);

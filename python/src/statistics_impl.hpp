@@ -22,10 +22,6 @@
 namespace bireg_python {
 namespace statistics_detail {
 
-[[noreturn]] inline void refuse(const std::string& message) {
-  throw nb::value_error(message.c_str());
-}
-
 template <class G>
 nb::dict mean_of(const Stack& y, const Vector& w, double tolerance, int max_iterations) {
   bireg::MeanOptions<double> options;
@@ -107,12 +103,10 @@ Output confidence_band(const GroupFit<G>& fit, const Vector& t, double level,
   const bireg::FitCovariance<G> c = covariance_of(fit, flavour_of(flavour));
   const std::optional<double> q = bireg::pose_quantile(c, level);
   if (!q) refuse("confidence_band: too few degrees of freedom for a quantile at this level");
+  check_covariates(t, "confidence_band");
   std::vector<typename G::Tangent> rows(t.shape(0));
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!std::isfinite(t.data()[i]))
-      refuse("confidence_band: covariate " + std::to_string(i) + " is not finite");
+  for (std::size_t i = 0; i < rows.size(); ++i)
     rows[i] = bireg::half_widths(bireg::pose_covariance(c, t.data()[i]), *q);
-  }
   return tangent_rows<G>(rows);
 }
 
@@ -133,7 +127,7 @@ double score(const GroupFit<G>& fit, const Vector& t, const Stack& y) {
     nb::gil_scoped_release release;
     mean = bireg::mean<G>(poses);
     for (std::size_t i = 0; i < poses.size(); ++i)
-      residuals[i] = G::log(G::compose(G::inverse(geodesic(t.data()[i])), poses[i]));
+      residuals[i] = bireg::log_at<G>(geodesic(t.data()[i]), poses[i]);
   }
   if (!mean.ok()) refuse("score: the mean of Y did not converge: " + mean.message);
   for (std::size_t i = 0; i < residuals.size(); ++i)
@@ -305,7 +299,7 @@ Output GroupStatistics<G>::confidence_band(const FitHandle& fit, const Vector& t
 template <class G>
 double GroupStatistics<G>::score(const FitHandle& fit, const Vector& t, const Stack& y) {
   if (y.shape(1) != std::size_t(side<G>()) || y.shape(2) != std::size_t(side<G>()))
-    statistics_detail::refuse("score: Y's matrices do not match the fit's group");
+    refuse("score: Y's matrices do not match the fit's group");
   return statistics_detail::score(as_group_fit<G>(fit), t, y);
 }
 
