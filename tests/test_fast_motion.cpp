@@ -59,33 +59,32 @@ Velocities auto_velocity(const RotationTrack& track) {
   return out;
 }
 
-// The bounds bireg does not meet yet, measured (2026-11-25, figures in
-// the README's gyroscope table): at 25 Hz a 10-20 rad/s spin leaves 2-3
-// samples per window (the turn allows no more), and the chart line, which
-// may span 5 rad, averages more of them; the whip's noisy rows and a
-// 20 rad/s spin at 50 Hz with 0.02 rad are 1.2-1.5x the chart line at its
-// best bandwidth; at 100 Hz with 0.02 rad the chords' noise (1.4 rad/s
-// per axis) swamps the velocity's error (0.13) in the velocity's
-// criterion, and on this sample of a 10 rad/s spin it picks the pose's
-// bandwidth, 1.5x the chart line at its best; on the x-IMU recording even
-// that chart line is 0.6-1.0x finite differences, so 0.5x is out of any
-// smoother's reach.
+// The bounds bireg does not meet yet, measured (2026-11-26, figures in
+// the README's gyroscope table). "At most 0.5x finite differences", on
+// data where even the chart line at the bandwidth best against the truth
+// (which no smoother can see) is 0.64-0.68x finite differences (the 25 Hz
+// spins with noise; bireg is 0.52-0.65x there) or 0.6-1.0x (the x-IMU
+// recording at 50 and 25 Hz, already smoothed by the device's filter;
+// bireg within 1.01-1.09x of that chart line). "1.15x the chart line" on
+// the whip with noise (1.24-1.39x): its rest at both ends, where the
+// end-of-data quadratic correction adds variance and removes no bias
+// (the chart line has no such correction); shrinking the correction by
+// its significance closed these (1.04-1.12x) but made the velocity's
+// cross-validation curve ragged on slow data (a constant spin's velocity
+// 3x worse), so it is not in. Every other "1.15x the chart line" bound is
+// met since the wide windows (statistics/local_wide.hpp) and the
+// five-point target of the velocity's cross-validation.
 struct Gap {
   const char* name;
   const char* bound;
 };
+
 const Gap kKnownGaps[] = {
     {"spin 10 rad/s at 25 Hz, noise 0.005", "0.5 differences"},
     {"spin 20 rad/s at 25 Hz, noise 0.005", "0.5 differences"},
-    {"spin 20 rad/s at 25 Hz, noise 0.005", "1.15 chart"},
-    {"whip 16 rad/s at 60 Hz, noise 0.005", "1.15 chart"},
-    {"whip 16 rad/s at 120 Hz, noise 0.005", "1.15 chart"},
-    {"spin 10 rad/s at 25 Hz, noise 0.02", "1.15 chart"},
-    {"spin 10 rad/s at 25 Hz, noise 0.02", "0.5 differences"},
-    {"spin 20 rad/s at 25 Hz, noise 0.02", "1.15 chart"},
     {"spin 20 rad/s at 25 Hz, noise 0.02", "0.5 differences"},
-    {"spin 20 rad/s at 50 Hz, noise 0.02", "1.15 chart"},
-    {"spin 10 rad/s at 100 Hz, noise 0.02", "1.15 chart"},
+    {"whip 16 rad/s at 120 Hz, noise 0.005", "1.15 chart"},
+    {"whip 16 rad/s at 60 Hz, noise 0.02", "1.15 chart"},
     {"whip 16 rad/s at 120 Hz, noise 0.02", "1.15 chart"},
     {"x-IMU at 50 Hz, noise 0.005", "0.5 differences"},
     {"x-IMU at 25 Hz, noise 0.005", "0.5 differences"},
@@ -252,22 +251,30 @@ TEST_CASE("Known gaps against the issue's bounds", "[fast][!mayfail]") {
 // wrong side.
 TEST_CASE("A bandwidth far too wide for a fast spin still gives a valid local estimate", "[fast]") {
   const RotationTrack track = motion::sample_rotation(motion::spin(20.0), 4.0, 50.0, 0.0, 11);
-  bireg::LocalRegressionOptions<double> options;
-  options.bandwidth = 1.0;
-  const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(track.f, track.t);
-  std::vector<SO3::Tangent> velocity;
-  for (const auto& e : estimates) {
-    REQUIRE(e.ok());
-    // The cut: every observation within max_turn / 2 = 1.25 rad of the
-    // anchor, at 0.3-0.5 rad between samples (15-25 rad/s) at most 4 on
-    // each side, far below the kernel's 200.
-    CHECK(e.window <= 9);
-    velocity.push_back(e.velocity);
+  for (const bool wide : {false, true}) {
+    bireg::LocalRegressionOptions<double> options;
+    options.bandwidth = 1.0;
+    options.wide_windows = wide;
+    const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(track.f, track.t);
+    std::vector<SO3::Tangent> velocity;
+    for (const auto& e : estimates) {
+      REQUIRE(e.ok());
+      // The cut: every observation within max_turn / 2 = 1.25 rad of the
+      // anchor, at 0.3-0.5 rad between samples (15-25 rad/s) at most 4 on
+      // each side, far below the kernel's 200; the wide window's path of
+      // 2.5 rad on each side at most 8.
+      CHECK(e.window <= (wide ? 17u : 9u));
+      velocity.push_back(e.velocity);
+    }
+    // Before the cut the error was the whole signal (15-25 rad/s). A flat
+    // window leaves the curvature's bias, which grows with the square of
+    // its length: 1 % of the slowest rate over +-4 samples, and twice the
+    // length, 4x that and the axis's precession (1 rad/s) over 0.3 s,
+    // under 7 % over +-8 (measured 0.81 rad/s). The bandwidth choice
+    // (select_bandwidth) never lands here: it is the wide windows' price
+    // for a bandwidth the data cannot support.
+    CHECK(motion::rms_error(velocity, track.velocity) < (wide ? 1.0 : 0.15));
   }
-  // Before the cut the error was the whole signal (15-25 rad/s); the cut
-  // windows, flat-topped over +-4 samples, leave the curvature's bias: 1 %
-  // of the slowest rate at most.
-  CHECK(motion::rms_error(velocity, track.velocity) < 0.15);
 }
 
 // The cut is left and right invariant (turn_angle of f_a^{-1} f_b is

@@ -35,7 +35,10 @@
 // fails is refitted cold and then on narrower windows (estimate_at), and a
 // query that fails at every width says so: ok() is false and `message`
 // says why (its pose and velocity are the last iterate's, for diagnosis,
-// not an estimate).
+// not an estimate). Where the cut shortened the window, the wide fit
+// (local_wide.hpp, Options::wide_windows) refits the window that may turn
+// by max_turn on each side, carried by (g0, X) so that the turn may pass
+// pi, and replaces the estimate when it converges.
 //
 // Options::robust makes every query a robust fit (statistics/robust.hpp).
 #pragma once
@@ -60,6 +63,7 @@
 #include "bireg/statistics/confidence.hpp"
 #include "bireg/statistics/covariance.hpp"
 #include "bireg/statistics/kernel.hpp"
+#include "bireg/statistics/local_wide.hpp"
 #include "bireg/statistics/local_window.hpp"
 #include "bireg/statistics/robust.hpp"
 
@@ -112,6 +116,16 @@ struct LocalRegressionOptions {
   // variances. Robust queries (`robust` below) report the robust
   // geodesic's velocity: this does not apply to them.
   bool quadratic_velocity = true;
+  // Where the turn cut shortened a window (fast rotation), refit the
+  // window that may turn by max_turn on each side of the query (its path,
+  // local_window.hpp's path_radius) instead of max_turn in all, carried by
+  // (g0, X) so that the whole turn may pass pi (statistics/local_wide.hpp:
+  // the same estimator in other coordinates), from the narrow window's
+  // geodesic. Twice the turn is up to twice the samples in the velocity
+  // when the motion is fast for its sampling rate. A wide fit that does
+  // not converge leaves the narrow estimate as it was. Not for robust
+  // queries.
+  bool wide_windows = true;
   // Threads for the queries (>= 1; 1: the calling thread only), in blocks
   // of 1024 queries whatever the count, so the estimates do not depend on
   // it. The local fits themselves stay serial (`fit.threads` is not used).
@@ -138,6 +152,9 @@ struct LocalEstimate {
   // The fit over the whole window failed and this estimate is from the
   // window narrowed about the query (LocalGeodesicRegression's fallback).
   bool narrowed = false;
+  // The estimate is the wide fit's (Options::wide_windows), on `window`
+  // observations past the narrow window's turn.
+  bool widened = false;
   // With Options::robust: how the reweighting ended, its rounds, and the
   // window's observations it flagged as outliers (their covariates).
   std::optional<RobustStatus> robust_status;
@@ -161,6 +178,7 @@ struct LocalEstimate {
     iterations = 0;
     window = 0;
     narrowed = false;
+    widened = false;
     robust_status.reset();
     robust_rounds = 0;
     outlier_covariates.clear();
@@ -171,6 +189,10 @@ struct LocalEstimate {
 enum class HoldOut {
   one,     // each observation: the pose's prediction error
   chords,  // each observation's chord between its neighbours: the velocity's error
+  // the velocity's error against each observation's five-point derivative
+  // (local_window.hpp, five_point_target), less biased than the chord where
+  // the motion is fast for its sampling rate, noisier where it is not
+  derivatives,
 };
 
 template <class G>
@@ -178,8 +200,8 @@ struct HeldOut {
   std::string problem;                      // the input was refused (then nothing else is set)
   std::vector<typename G::Tangent> errors;  // per observation, input order
   std::vector<char> ok;                     // whether errors[i] exists
-  // HoldOut::chords: c_i, the covariance of v_i's noise with d_i's per
-  // unit of the observations' noise covariance (held_out).
+  // HoldOut::chords and derivatives: c_i, the covariance of v_i's noise
+  // with d_i's per unit of the observations' noise covariance (held_out).
   std::vector<typename G::Scalar> cross;
   std::size_t failures = 0;   // queries whose local fit failed at every width
   std::string first_failure;  // the first of them (in covariate order), why
@@ -237,13 +259,13 @@ class LocalGeodesicRegression {
                      [&](std::size_t a, std::size_t b) { return queries[a] < queries[b]; });
 
     for_each_block(queries.size(), [&](std::size_t begin, std::size_t end) {
-      Window window;
+      Windows windows;
       FitBuffers buffers;
       std::optional<Geodesic<G>> previous;
       for (std::size_t k = begin; k < end; ++k) {
         const std::size_t q = query_order[k];
-        fill_window<G>(sorted_f, sorted_t, queries[q], shape(), window, n);
-        estimate_at(queries[q], window, previous, buffers, estimates[q]);
+        fill_windows(sorted_f, sorted_t, queries[q], windows, n);
+        estimate_at(queries[q], windows, previous, buffers, estimates[q]);
       }
     });
     return estimates;
@@ -278,7 +300,11 @@ class LocalGeodesicRegression {
   // squared error) + (d_i's) - 2 c_i Sigma for noise of covariance Sigma,
   // which select_bandwidth adds back (DESIGN.md section 5, "Choosing the
   // bandwidth for the velocity"). Not defined for the first and last
-  // observation. Both kinds of error are left invariant and map by
+  // observation. HoldOut::derivatives: the same with d_i the five-point
+  // derivative at t_i (five_point_target) and v_i at t_i, c_i = sum_j a_j
+  // l_j over its five observations; where it is undefined (the two first
+  // and last observations, a turn past max_turn) the chord stands in.
+  // Both kinds of error are left invariant and map by
   // Ad_{h^{-1}} under right translation by h.
   template <class Observations, class Covariates>
   HeldOut<G> held_out(const Observations& observations, const Covariates& covariates,
@@ -293,7 +319,7 @@ class LocalGeodesicRegression {
     sort_by_covariate(observations, covariates, order, sorted_t, sorted_f);
     held.errors.assign(n, Tangent::Zero());
     held.ok.assign(n, 0);
-    if (mode == HoldOut::chords) held.cross.assign(n, Scalar(0));
+    if (mode != HoldOut::one) held.cross.assign(n, Scalar(0));
     // Robust queries report the robust geodesic's velocity.
     const bool quadratic = options_.quadratic_velocity && !options_.robust;
     // Per block, its first failure: the first block's that is set is the
@@ -301,23 +327,31 @@ class LocalGeodesicRegression {
     std::vector<std::string> block_failures(block_count(n));
     std::vector<std::size_t> block_counts(block_count(n), 0);
     for_each_block(n, [&](std::size_t begin, std::size_t end) {
-      Window window;
+      Windows windows;
       FitBuffers buffers;
       std::optional<Geodesic<G>> previous;
       Estimate estimate;
       for (std::size_t i = begin; i < end; ++i) {
         Scalar tau = sorted_t[i];
         Tangent target = Tangent::Zero();
-        if (mode == HoldOut::chords) {
+        DerivativeTarget<G> five;
+        if (mode != HoldOut::one) {
           if (i == 0 || i + 1 == n || !(sorted_t[i + 1] > sorted_t[i - 1])) continue;
-          tau = (sorted_t[i - 1] + sorted_t[i + 1]) / 2;
-          target = G::log(G::compose(G::inverse(sorted_f[i - 1]), sorted_f[i + 1])) /
-                   (sorted_t[i + 1] - sorted_t[i - 1]);
-          fill_window<G>(sorted_f, sorted_t, tau, shape(), window, n);
+          if (mode == HoldOut::derivatives) {
+            five = five_point_target<G>(sorted_f, sorted_t, i, options_.max_turn);
+          }
+          if (five.defined) {
+            target = five.velocity;
+          } else {
+            tau = (sorted_t[i - 1] + sorted_t[i + 1]) / 2;
+            target = G::log(G::compose(G::inverse(sorted_f[i - 1]), sorted_f[i + 1])) /
+                     (sorted_t[i + 1] - sorted_t[i - 1]);
+          }
+          fill_windows(sorted_f, sorted_t, tau, windows, n);
         } else {
-          fill_window<G>(sorted_f, sorted_t, tau, shape(), window, i);
+          fill_windows(sorted_f, sorted_t, tau, windows, i);
         }
-        estimate_at(tau, window, previous, buffers, estimate);
+        estimate_at(tau, windows, previous, buffers, estimate);
         if (!estimate.ok()) {
           const std::size_t block = begin / kQueryBlock;
           if (block_counts[block]++ == 0) {
@@ -331,15 +365,25 @@ class LocalGeodesicRegression {
         }
         // A chord whose velocity came from a narrowed window has no c_i
         // from this window: left out, neither compared nor a failure.
-        if (mode == HoldOut::chords && estimate.narrowed) continue;
+        if (mode != HoldOut::one && estimate.narrowed) continue;
         held.ok[order[i]] = 1;
         if (mode == HoldOut::one) {
           held.errors[order[i]] = G::log(G::compose(G::inverse(estimate.pose), sorted_f[i]));
         } else {
+          const Window& used = estimate.widened ? windows.wide : windows.narrow;
           held.errors[order[i]] = estimate.velocity - target;
-          held.cross[order[i]] = (slope_weight<G>(window, tau, sorted_t[i + 1], quadratic) -
-                                  slope_weight<G>(window, tau, sorted_t[i - 1], quadratic)) /
-                                 (sorted_t[i + 1] - sorted_t[i - 1]);
+          Scalar cross = 0;
+          const auto slope_weight_of = [&](Scalar covariate) {
+            return slope_weight<G>(used, tau, covariate, quadratic);
+          };
+          if (five.defined) {
+            for (std::size_t k = 0; k < 5; ++k)
+              cross += five.weights[k] * slope_weight_of(sorted_t[i - 2 + k]);
+          } else {
+            cross = (slope_weight_of(sorted_t[i + 1]) - slope_weight_of(sorted_t[i - 1])) /
+                    (sorted_t[i + 1] - sorted_t[i - 1]);
+          }
+          held.cross[order[i]] = cross;
         }
       }
     });
@@ -408,7 +452,23 @@ class LocalGeodesicRegression {
   using Window = LocalWindow<G>;
 
   WindowShape<Scalar> shape() const {
-    return {options_.kernel, options_.bandwidth, options_.max_turn};
+    return {options_.kernel, options_.bandwidth, options_.max_turn, false};
+  }
+
+  // A query's window, and its wide window when the turn cut shortened it
+  // (Options::wide_windows; otherwise `wide` is empty).
+  struct Windows {
+    Window narrow;
+    Window wide;
+  };
+  void fill_windows(const std::vector<Element>& f, const std::vector<Scalar>& t, Scalar tau,
+                    Windows& windows, std::size_t excluded) const {
+    const bool cut = fill_window<G>(f, t, tau, shape(), windows.narrow, excluded);
+    windows.wide.clear();
+    if (!cut || !options_.wide_windows || options_.robust) return;
+    WindowShape<Scalar> wide = shape();
+    wide.wide = true;
+    fill_window<G>(f, t, tau, wide, windows.wide, excluded);
   }
 
   // Queries run in blocks of kQueryBlock consecutive ones (in ascending
@@ -441,8 +501,34 @@ class LocalGeodesicRegression {
   // The estimate at tau from its window, into `estimate` (whose vectors
   // and message keep their capacity); `previous` is the last successful
   // local geodesic, updated here.
-  void estimate_at(Scalar tau, const Window& window, std::optional<Geodesic<G>>& previous,
+  void estimate_at(Scalar tau, const Windows& windows, std::optional<Geodesic<G>>& previous,
                    FitBuffers& buffers, Estimate& estimate) const {
+    estimate_narrow(tau, windows.narrow, previous, buffers, estimate);
+    if (estimate.ok() && windows.wide.covariates.size() > windows.narrow.covariates.size()) {
+      widen(windows.wide, estimate);
+    }
+  }
+
+  // Options::wide_windows: the wide fit from the narrow estimate's
+  // geodesic, which it replaces when it converges.
+  void widen(const Window& wide, Estimate& estimate) const {
+    const WideFit<G> fit =
+        wide_fit<G>(wide, estimate.covariate, estimate.pose, estimate.velocity,
+                    options_.fit.tolerance, options_.fit.max_iterations, options_.standard_errors);
+    estimate.iterations += fit.iterations;
+    if (!fit.converged) return;
+    estimate.pose = fit(estimate.covariate);
+    estimate.velocity = fit.body_velocity();
+    estimate.velocity_error = fit.velocity_error;
+    estimate.velocity_error_defined = fit.velocity_error_defined;
+    estimate.window = wide.covariates.size();
+    estimate.widened = true;
+    if (options_.quadratic_velocity) add_quadratic_slope(fit, wide, estimate);
+  }
+
+  // The estimate on the narrow window, with the fallback below.
+  void estimate_narrow(Scalar tau, const Window& window, std::optional<Geodesic<G>>& previous,
+                       FitBuffers& buffers, Estimate& estimate) const {
     estimate_in(tau, window, previous, buffers, estimate);
     if (estimate.ok() || options_.robust || estimate.window < 3 ||
         estimate.status == Status::max_iterations) {
@@ -613,8 +699,8 @@ class LocalGeodesicRegression {
   // Options::quadratic_velocity: the slope of the quadratic fit of the
   // local geodesic's residuals (local_window.hpp, quadratic_slope) added to
   // its velocity, the standard errors scaled to the quadratic design's.
-  static void add_quadratic_slope(const Geodesic<G>& local, const Window& window,
-                                  Estimate& estimate) {
+  template <class Curve>
+  static void add_quadratic_slope(const Curve& local, const Window& window, Estimate& estimate) {
     const QuadraticSlope<G> quadratic = quadratic_slope<G>(local, window, estimate.covariate);
     if (!quadratic.defined) return;
     estimate.velocity += quadratic.slope;

@@ -32,14 +32,30 @@ struct LocalWindow {
 };
 
 // What decides a window: the kernel, its bandwidth, and the most the
-// window may turn (LocalRegressionOptions).
+// window may turn (LocalRegressionOptions). A `wide` window may turn by
+// max_turn on each side of the query (path_radius) instead of max_turn in
+// all (turn_radius), for the wide fit (statistics/local_wide.hpp).
 template <class Scalar>
 struct WindowShape {
   Kernel kernel = Kernel::gaussian;
   Scalar bandwidth = Scalar(1);
   Scalar max_turn = Scalar(2.5);
+  bool wide = false;
   Scalar reach() const { return Scalar(kernel_support(kernel)) * bandwidth; }
 };
+
+// The index in [begin, end) whose covariate is nearest tau (the first of
+// equals); `begin` when the range is empty.
+template <class Scalar>
+std::size_t nearest_observation(const std::vector<Scalar>& t, Scalar tau, std::size_t begin,
+                                std::size_t end) {
+  using std::abs;
+  std::size_t nearest = begin;
+  for (std::size_t i = begin + 1; i < end; ++i) {
+    if (abs(t[i] - tau) < abs(t[nearest] - tau)) nearest = i;
+  }
+  return nearest;
+}
 
 // How far from tau the window may reach while it turns steadily less
 // than max_turn: from the anchor a, the observation nearest tau, walk
@@ -53,11 +69,14 @@ struct WindowShape {
 // turns by at most max_turn, and the cut is left and right invariant. One
 // observation alone beyond the ball is an outlier, not a turn: it stays in
 // the window, for the fit (or a robust fit) to weigh, as it would without
-// the cut. An anchor that is itself such an outlier (both its neighbours
-// beyond its ball) is replaced by the next nearest observation. The anchor
-// may be an observation that cross-validation holds out: the held-out
-// window is then the full data's window without it, which is what
-// leave-one-out should imitate.
+// the cut. Its successor is looked at past the kernel's reach too, and an
+// observation beyond the ball that ends the data counts as a turn: else a
+// window whose reach ends one sample past the ball kept a turn of up to
+// twice max_turn (a spin of 0.8 rad per sample at a bandwidth of 0.66
+// spacings: five samples over 3.2 rad, every fit failing). An anchor that is itself such an outlier
+// (both its neighbours beyond its ball) is replaced by the next nearest observation. The anchor may
+// be an observation that cross-validation holds out: the held-out window is then the full data's
+// window without it, which is what leave-one-out should imitate.
 template <class G>
 typename G::Scalar turn_radius(const std::vector<typename G::Element>& f,
                                const std::vector<typename G::Scalar>& t, typename G::Scalar tau,
@@ -75,10 +94,7 @@ typename G::Scalar turn_radius(const std::vector<typename G::Element>& f,
     };
     // The nearest observation, or the next nearest when the nearest is
     // beyond the ball of both its neighbours in the window.
-    std::size_t anchor = begin;
-    for (std::size_t i = begin + 1; i < end; ++i) {
-      if (abs(t[i] - tau) < abs(t[anchor] - tau)) anchor = i;
-    }
+    std::size_t anchor = nearest_observation(t, tau, begin, end);
     const bool has_left = anchor > begin, has_right = anchor + 1 < end;
     if ((!has_left || beyond(anchor, anchor - 1)) && (!has_right || beyond(anchor, anchor + 1))) {
       if (!has_left) {
@@ -90,12 +106,21 @@ typename G::Scalar turn_radius(const std::vector<typename G::Element>& f,
       }
     }
     Scalar radius = reach;
-    // One side: `next` steps j outward while `more(j)`; the bound is the
-    // first of two consecutive observations beyond the ball.
-    const auto walk = [&](auto next, auto more) {
+    // One side: `next` steps j outward while `in_reach(j)`; the bound is
+    // the first of two consecutive observations beyond the ball. The
+    // second may lie past the reach (the data goes on there): the last
+    // observation in reach beyond the ball is a turn when the next one is
+    // beyond it too, or when the data ends there.
+    const auto walk = [&](auto next, auto in_reach, auto in_data) {
       bool previous_beyond = false;
       std::size_t first = anchor;
-      for (std::size_t j = next(anchor); more(j); j = next(j)) {
+      for (std::size_t j = next(anchor);; j = next(j)) {
+        if (!in_data(j) || !in_reach(j)) {
+          if (previous_beyond && (!in_data(j) || beyond(anchor, j))) {
+            radius = std::min(radius, abs(t[first] - tau));
+          }
+          return;
+        }
         if (!beyond(anchor, j)) {
           previous_beyond = false;
           continue;
@@ -108,19 +133,68 @@ typename G::Scalar turn_radius(const std::vector<typename G::Element>& f,
         first = j;
       }
     };
-    walk([](std::size_t j) { return j + 1; }, [&](std::size_t j) { return j < end; });
+    walk([](std::size_t j) { return j + 1; }, [&](std::size_t j) { return j < end; },
+         [&](std::size_t j) { return j < t.size(); });
     // Leftward, j - 1 wraps to the largest size_t past 0, where j + 1 = 0.
-    walk([](std::size_t j) { return j - 1; }, [&](std::size_t j) { return j + 1 > begin; });
+    walk([](std::size_t j) { return j - 1; }, [&](std::size_t j) { return j + 1 > begin; },
+         [](std::size_t j) { return j + 1 > 0; });
+    return radius;
+  }
+}
+
+// How far from tau a wide window may reach: on each side of the
+// observation nearest tau, the motion's path, the sum of the turn angles
+// between consecutive observations, may grow to max_turn; the radius is
+// the smaller side's distance |t_j - tau| to the first observation j past
+// that (symmetric in time, as turn_radius), or `reach`. The path, unlike
+// turn_radius's distance from the anchor, does not fold back past pi (a
+// spin of 0.8 rad per sample is 4.0 rad from the anchor after five
+// samples and 2.28 rad by the principal angle), so the motion within the
+// window turns by at most 2 max_turn (below 2 pi for max_turn <= 2.5, the
+// wide fit's domain). A sum of bi-invariant distances: left and right
+// invariant. Noise lengthens the path, so the window can only come out
+// narrower than the motion allows, never wider.
+template <class G>
+typename G::Scalar path_radius(const std::vector<typename G::Element>& f,
+                               const std::vector<typename G::Scalar>& t, typename G::Scalar tau,
+                               typename G::Scalar reach, std::size_t begin, std::size_t end,
+                               typename G::Scalar max_turn) {
+  using Scalar = typename G::Scalar;
+  if constexpr (!has_turn_angle_v<G>) {
+    return reach;
+  } else {
+    using std::abs;
+    if (end - begin < 2) return reach;
+    const std::size_t anchor = nearest_observation(t, tau, begin, end);
+    Scalar radius = reach;
+    Scalar path = 0;
+    for (std::size_t j = anchor + 1; j < end; ++j) {
+      path += G::turn_angle(G::compose(G::inverse(f[j - 1]), f[j]));
+      if (path > max_turn) {
+        radius = std::min(radius, abs(t[j] - tau));
+        break;
+      }
+    }
+    path = 0;
+    for (std::size_t j = anchor; j > begin; --j) {
+      path += G::turn_angle(G::compose(G::inverse(f[j]), f[j - 1]));
+      if (path > max_turn) {
+        radius = std::min(radius, abs(t[j - 1] - tau));
+        break;
+      }
+    }
     return radius;
   }
 }
 
 // The observations with positive kernel weight at tau, ascending, cut
-// where the window would turn by more than `shape.max_turn` (turn_radius).
+// where the window would turn by more than `shape.max_turn` (turn_radius);
+// a `wide` shape keeps the larger of that window and path_radius's.
 // `excluded` and `also_excluded`: sorted indices held out
-// (cross-validation), or any index past the end for none.
+// (cross-validation), or any index past the end for none. Returns whether
+// the turn cut left out an observation the kernel would have kept.
 template <class G>
-void fill_window(const std::vector<typename G::Element>& f,
+bool fill_window(const std::vector<typename G::Element>& f,
                  const std::vector<typename G::Scalar>& t, typename G::Scalar tau,
                  const WindowShape<typename G::Scalar>& shape, LocalWindow<G>& window,
                  std::size_t excluded, std::size_t also_excluded = std::size_t(-1)) {
@@ -131,20 +205,28 @@ void fill_window(const std::vector<typename G::Element>& f,
   const auto last = std::upper_bound(t.begin(), t.end(), tau + reach);
   const std::size_t begin = static_cast<std::size_t>(first - t.begin());
   const std::size_t end = static_cast<std::size_t>(last - t.begin());
-  const Scalar radius = turn_radius<G>(f, t, tau, reach, begin, end, shape.max_turn);
+  Scalar radius = turn_radius<G>(f, t, tau, reach, begin, end, shape.max_turn);
+  if (shape.wide && radius < reach) {
+    radius = std::max(radius, path_radius<G>(f, t, tau, reach, begin, end, shape.max_turn));
+  }
+  bool cut = false;
   for (std::size_t i = begin; i < end; ++i) {
     if (i == excluded || i == also_excluded) continue;
     const Scalar offset = t[i] - tau;
-    if (radius < reach && !(std::abs(offset) < radius)) continue;
+    if (radius < reach && !(std::abs(offset) < radius)) {
+      cut = cut || kernel_weight(shape.kernel, offset / shape.bandwidth) > 0;
+      continue;
+    }
     const Scalar weight = kernel_weight(shape.kernel, offset / shape.bandwidth);
     if (!(weight > 0)) continue;
     window.observations.push_back(f[i]);
     window.covariates.push_back(t[i]);
     window.weights.push_back(weight);
   }
+  return cut;
 }
 
-// The slope of a quadratic fit of a local geodesic's residuals (below).
+// The slope of a quadratic fit of a local curve's residuals (below).
 template <class G>
 struct QuadraticSlope {
   bool defined = false;
@@ -161,9 +243,10 @@ struct QuadraticSlope {
 // geodesic's (a local line's) the same with z_i = (1, u_i): error_ratio is
 // the square root of their ratio, by which the standard errors are scaled.
 // Not defined when the window has fewer than three distinct covariates or
-// M is singular to working precision.
-template <class G>
-QuadraticSlope<G> quadratic_slope(const Geodesic<G>& local, const LocalWindow<G>& window,
+// M is singular to working precision. `local(t)` is the local geodesic's
+// pose at t (a Geodesic<G>, or the wide fit's curve).
+template <class G, class Curve>
+QuadraticSlope<G> quadratic_slope(const Curve& local, const LocalWindow<G>& window,
                                   typename G::Scalar tau) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
@@ -205,6 +288,63 @@ QuadraticSlope<G> quadratic_slope(const Geodesic<G>& local, const LocalWindow<G>
       line_row.dot(squared_weights.template topLeftCorner<2, 2>() * line_row);
   if (line_variance > 0) result.error_ratio = sqrt(quadratic_variance / line_variance);
   return result;
+}
+
+// The velocity's cross-validation target at the sorted observation i
+// (LocalGeodesicRegression::held_out, HoldOut::chords): the derivative at
+// t_i of the quartic through y_j = log(f_i^{-1} f_j), j = i-2 .. i+2 (so
+// y_i = 0), sum_j a_j y_j with a_j = L_j'(t_i) the Lagrange basis'
+// derivatives (sum_j a_j = 0). The body velocity at f_i is d/dt log(f_i^{-1}
+// f(t)) at t_i, and that chart is a power series in t - t_i, so the target
+// is the velocity up to O(dt^4) where the chord between i's neighbours is
+// up to O(dt^2): on a spin of 20 rad/s at 25 Hz the chords alone are 0.22
+// rad/s off, and cross-validation against them chose the bandwidth whose
+// bias matched theirs (DESIGN.md section 5). Undefined at the two ends,
+// where two of the five covariates coincide, or where f_j turns from f_i
+// by more than max_turn (the chart would fold).
+template <class G>
+struct DerivativeTarget {
+  bool defined = false;
+  typename G::Tangent velocity = G::Tangent::Zero();
+  typename G::Scalar weights[5] = {0, 0, 0, 0, 0};  // a_j, j = i-2 .. i+2
+};
+
+template <class G>
+DerivativeTarget<G> five_point_target(const std::vector<typename G::Element>& f,
+                                      const std::vector<typename G::Scalar>& t, std::size_t i,
+                                      typename G::Scalar max_turn) {
+  using Scalar = typename G::Scalar;
+  DerivativeTarget<G> target;
+  if (i < 2 || i + 2 >= t.size()) return target;
+  for (std::size_t j = i - 2; j < i + 2; ++j) {
+    if (!(t[j + 1] > t[j])) return target;
+  }
+  const typename G::Element origin_inverse = G::inverse(f[i]);
+  for (int k = 0; k < 5; ++k) {
+    const std::size_t j = i - 2 + static_cast<std::size_t>(k);
+    Scalar weight = 0;
+    if (j == i) {
+      for (std::size_t m = i - 2; m <= i + 2; ++m) {
+        if (m != i) weight += Scalar(1) / (t[i] - t[m]);
+      }
+    } else {
+      Scalar numerator = 1, denominator = 1;
+      for (std::size_t m = i - 2; m <= i + 2; ++m) {
+        if (m == j) continue;
+        denominator *= t[j] - t[m];
+        if (m != i) numerator *= t[i] - t[m];
+      }
+      weight = numerator / denominator;
+      const typename G::Element relative = G::compose(origin_inverse, f[j]);
+      if constexpr (has_turn_angle_v<G>) {
+        if (!(G::turn_angle(relative) <= max_turn)) return target;
+      }
+      target.velocity += weight * G::log(relative);
+    }
+    target.weights[k] = weight;
+  }
+  target.defined = target.velocity.allFinite();
+  return target;
 }
 
 // The weight l of the observation at `covariate` in the local slope at
