@@ -18,11 +18,11 @@ def spinning(n=200, rate=100.0, omega=(0.0, 0.0, 6.0), noise=0.01, seed=3):
 
 def test_velocity_of_a_constant_spin_with_auto_bandwidth():
     t, Y = spinning()
-    # A constant velocity is estimated best from the widest window: the
-    # velocity's choice is the grid's last value, and the user is told so.
-    with pytest.warns(UserWarning, match="velocity's choice is the grid's largest value"):
-        local = bireg.LocalRegression(group="SO3", bandwidth="auto").fit(t, Y)
-    assert local.velocity_bandwidth_ == local.bandwidth_selection_["grid"][-1]
+    # 6 rad/s at 100 Hz: the turn cut binds from 0.1 s on, and past that
+    # the velocity's criterion is flat to 0.2 % (its choice moves within
+    # that noise, README "Local regression"); what must hold is the
+    # velocity itself, against its reported standard errors.
+    local = bireg.LocalRegression(group="SO3", bandwidth="auto").fit(t, Y)
     assert local.bandwidth_ > 0 and local.velocity_bandwidth_ > 0
     out = local.velocity(t[20:-20])
     assert out["ok"].all()
@@ -32,6 +32,15 @@ def test_velocity_of_a_constant_spin_with_auto_bandwidth():
     err = np.abs(v - [0.0, 0.0, 6.0])
     assert (err < 5 * out["velocity_standard_error"] + 1e-9).mean() > 0.95
     assert np.abs(v[:, 2] - 6.0).max() < 0.5
+
+
+def test_a_choice_at_the_grids_edge_is_reported():
+    # A slow constant spin (1 rad over 2 s): the pose is predicted best by
+    # the widest window, the grid's last value, and the user is told so.
+    t, Y = spinning(omega=(0.0, 0.0, 0.5))
+    with pytest.warns(UserWarning, match="pose's choice is the grid's largest value"):
+        local = bireg.LocalRegression(group="SO3", bandwidth="auto").fit(t, Y)
+    assert local.bandwidth_ == local.bandwidth_selection_["grid"][-1]
 
 
 def test_local_regression_is_equivariant(rng):
