@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
@@ -22,6 +23,7 @@
 namespace {
 
 using SO3 = bireg::SO3d;
+using SE2 = bireg::SE2d;
 using SE3 = bireg::SE3d;
 namespace motion = bireg::testing;
 
@@ -125,6 +127,53 @@ TEST_CASE("The wide fit is left and right equivariant on SE(3) past pi", "[wide]
         1e-9);
 }
 
+// The net force at the wide fit's solution, evaluated independently by
+// capabilities.hpp's apply_psi (the closed form of psi, or its series),
+// against the residuals' scale sum w |r|.
+template <class G>
+std::pair<double, double> force_at(const bireg::WideFit<G>& fit,
+                                   const bireg::LocalWindow<G>& window) {
+  typename G::Tangent v0 = G::Tangent::Zero(), v1 = G::Tangent::Zero();
+  double scale = 0;
+  for (std::size_t i = 0; i < window.covariates.size(); ++i) {
+    const double t = (window.covariates[i] - fit.t_first) / (fit.t_last - fit.t_first);
+    const typename G::Tangent r = G::log(G::compose(
+        G::exp(-t * fit.displacement), G::compose(G::inverse(fit.start), window.observations[i])));
+    const typename G::Tangent minus_x = -fit.displacement;
+    v0 += window.weights[i] * bireg::apply_psi<G>(minus_x, 1 - t, r);
+    v1 += window.weights[i] * bireg::apply_psi<G>(fit.displacement, t, r);
+    scale += window.weights[i] * r.norm();
+  }
+  return {std::max(v0.norm(), v1.norm()), scale};
+}
+
+// SE(2) has no closed-form J_r^{-1}: its Bernoulli series is off by 0.3 at
+// 5 rad (|J J^{-1} - I|), so the wide fit inverts J_r's own series there.
+TEST_CASE("On SE(2) past 5 rad the wide fit solves the estimating equations", "[wide]") {
+  // Over 1.2 s: 4.8 and 5.3 rad, and 6.0, past the domain (0.9 of 2 pi).
+  for (const double rate : {4.0, 4.4, 5.0}) {
+    SE2::Tangent v;
+    v << 1.0, -0.5, rate;
+    std::mt19937 rng(2);
+    const SE2::Element g = SE2::exp(bireg_test::normal_tangent<SE2::Tangent>(rng, 1.0));
+    const auto window = geodesic_window<SE2>(g, v, 25, 0.05, 0.4, 0.03, 4);
+    const bireg::WideFit<SE2> fit = bireg::wide_fit<SE2>(window, 0.0, g, v, 1e-12, 50, true);
+    INFO("rate " << rate << ", turn " << std::abs(fit.displacement[2]));
+    if (std::abs(rate * 1.2) >= 0.9 * 2 * 3.141592653589793) {
+      CHECK_FALSE(fit.converged);  // outside the domain: refused, not solved
+      continue;
+    }
+    REQUIRE(fit.converged);
+    const auto [force, scale] = force_at(fit, window);
+    // The step tolerance 1e-12 bounds the force by ~1e-12 K; the
+    // evaluations differ by rounding in psi (1e-13 relative).
+    CHECK(force < 1e-9 * scale);
+    // Noise 0.03 per coordinate over 25 samples: the velocity's error is
+    // a few 0.03 / (1.2 s sqrt(25 / 12)) = 0.017; 0.15 is 9 of those.
+    CHECK((fit.body_velocity() - v).norm() < 0.15);
+  }
+}
+
 TEST_CASE("The five-point target is exact on a geodesic and fourth order on a spin", "[wide]") {
   // A geodesic at uneven spacing: log(f_i^{-1} f_j) = (t_j - t_i) v exactly.
   const SO3::Tangent v(1.5, -0.5, 2.0);
@@ -178,6 +227,11 @@ TEST_CASE("Wide windows: at most 2 max_turn of path, and cut where the reach end
     options.bandwidth = h;
     options.standard_errors = false;
     const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(track.f, track.t);
+    std::size_t widened = 0;
+    for (const auto& e : estimates)
+      widened += e.widened ? 1 : 0;
+    // Past 0.66 spacings the cut binds everywhere and the wide fit takes over.
+    if (h >= 0.1) CHECK(widened == estimates.size());
     for (std::size_t q = 0; q < estimates.size(); ++q) {
       INFO("bandwidth " << h << " query " << q);
       // Before the cut looked past the kernel's reach, h = 0.0264 (reach

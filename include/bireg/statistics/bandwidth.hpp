@@ -263,9 +263,10 @@ Eigen::Matrix<typename G::Scalar, G::dof, G::dof> noise_scatter(const Observatio
 // criterion twice: its noise adds a constant (harmless, but it buries the
 // differences between bandwidths), its bias correlates with the
 // estimator's and moves the minimum. D_i's bias is O(dt^4) where d_i's is
-// O(dt^2), and its noise is larger (sum a_j^2 = 0.90 / dt^2 against 0.50 /
-// dt^2 for even spacing). Compared where both exist, d_i - D_i is d_i's bias
-// plus noise of covariance (sum_j (a_j - b_j)^2) Sigma (a, b their weights),
+// O(dt^2), and its noise is larger (the squares of its weights sum to
+// 0.90 / dt^2, the chord's to 0.50 / dt^2, for even spacing). Compared
+// where both exist, d_i - D_i is d_i's bias plus noise of covariance
+// (sum_j (a_j - b_j)^2) Sigma (a the chord's weights, b the derivative's),
 // so with Sigma^ = noise, in its whitened coordinates (invariant),
 //
 //   bias^2 = mean (d - D)^T Sigma^-1 (d - D) - dof mean sum_j (a_j - b_j)^2,

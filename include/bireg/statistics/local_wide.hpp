@@ -91,6 +91,23 @@ namespace wide_detail {
 template <class Scalar>
 constexpr Scalar kMaxRadius = Scalar(0.9) * Scalar(2) * Scalar(3.14159265358979323846);
 
+// J_r(x) and J_r(x)^{-1}, accurate at every angle the wide fit reaches
+// (spectral radius up to 0.9 of 2 pi). G's closed forms where it has the
+// inverse's (SO(3), SE(3)); elsewhere J_r's own series, which is entire,
+// inverted by LU: the Bernoulli series of the inverse (capabilities.hpp's
+// fallback) is accurate on the narrow fits' turns below pi but not here
+// (on SE(2), |J_r J_r^{-1} - I| = 0.3 at 5 rad, 1e4 at 5.65; found in
+// review, tests/test_local_wide.cpp checks SE(2) past 5 rad).
+template <class G>
+RightJacobianPair<typename G::AdMatrix> jacobian_pair(const typename G::Tangent& x) {
+  if constexpr (provides_v<G, capability_detail::right_jacobian_inverse>) {
+    return right_jacobian_pair<G>(x);
+  } else {
+    const typename G::AdMatrix jacobian = right_jacobian<G>(x);
+    return {jacobian, jacobian.inverse()};
+  }
+}
+
 // v, K and, when `sandwich`, M's pieces for the geodesic (g0, X) on the
 // window, t_i normalised onto [0, 1].
 template <class G>
@@ -120,8 +137,8 @@ Force<G> force(const LocalWindow<G>& window, const typename G::Element& g0,
   using AdMatrix = typename G::AdMatrix;
   constexpr int d = G::dof;
   Force<G> out;
-  const RightJacobianPair<AdMatrix> forward = right_jacobian_pair<G>(x);    // J_r(X), J_r(X)^{-1}
-  const RightJacobianPair<AdMatrix> backward = right_jacobian_pair<G>(-x);  // J_r(-X), inverse
+  const RightJacobianPair<AdMatrix> forward = jacobian_pair<G>(x);    // J_r(X), J_r(X)^{-1}
+  const RightJacobianPair<AdMatrix> backward = jacobian_pair<G>(-x);  // J_r(-X), inverse
   const typename G::Element g0_inverse = G::inverse(g0);
   AdMatrix k01_sum = AdMatrix::Zero(), k10_sum = AdMatrix::Zero();
   Tangent v0 = Tangent::Zero(), v1 = Tangent::Zero();
@@ -132,8 +149,8 @@ Force<G> force(const LocalWindow<G>& window, const typename G::Element& g0,
     const Scalar s = 1 - t;
     const Tangent r =
         G::log(G::compose(G::exp(-t * x), G::compose(g0_inverse, window.observations[i])));
-    const RightJacobianPair<AdMatrix> near = right_jacobian_pair<G>(t * x);  // J_r(tX)
-    const RightJacobianPair<AdMatrix> far = right_jacobian_pair<G>(-s * x);  // J_r(-(1-t)X)
+    const RightJacobianPair<AdMatrix> near = jacobian_pair<G>(t * x);  // J_r(tX)
+    const RightJacobianPair<AdMatrix> far = jacobian_pair<G>(-s * x);  // J_r(-(1-t)X)
     v0.noalias() += (w * s) * (far.inverse * r);
     v1.noalias() += (w * t) * (near.inverse * r);
     k01_sum.noalias() += (w * s * t) * (far.inverse * near.jacobian);
@@ -193,6 +210,9 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
   const Scalar range = fit.t_last - fit.t_first;
   fit.start = G::compose(start_pose, G::exp((fit.t_first - tau) * start_velocity));
   fit.displacement = range * start_velocity;
+  const auto inverse_jacobian = [](const Tangent& x) {
+    return wide_detail::jacobian_pair<G>(x).inverse;
+  };
   const auto inside = [](const Tangent& x) {
     return ad_spectral_radius<G>(x) < wide_detail::kMaxRadius<Scalar>;
   };
@@ -209,11 +229,10 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
     const Tangent d0 = step.template head<d>(), d1 = step.template tail<d>();
     // exp(X') = exp(-d0) exp(X) exp(d1): first order, then one correction.
     const Tangent x = fit.displacement;
-    const Tangent first_order =
-        x + right_jacobian_inverse<G>(x) * d1 - right_jacobian_inverse<G>(-x) * d0;
+    const Tangent first_order = x + inverse_jacobian(x) * d1 - inverse_jacobian(-x) * d0;
     const Tangent correction = G::log(G::compose(G::compose(G::exp(-first_order), G::exp(-d0)),
                                                  G::compose(G::exp(x), G::exp(d1))));
-    fit.displacement = first_order + right_jacobian_inverse<G>(first_order) * correction;
+    fit.displacement = first_order + inverse_jacobian(first_order) * correction;
     fit.start = G::compose(fit.start, G::exp(d0));
     if (!fit.displacement.allFinite() || !fit.start.allFinite() || !inside(fit.displacement)) {
       return fit;
@@ -223,6 +242,7 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
       break;
     }
   }
+  fit.iterations = std::min(fit.iterations, max_iterations);
   if (!fit.converged || !standard_errors) return fit;
 
   // The homoscedastic sandwich (covariance.hpp's, in these coordinates).
@@ -239,8 +259,8 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
   const Eigen::FullPivLU<typename Force::Matrix> transposed(k_transpose);
   if (transposed.rank() < 2 * d) return fit;
   Eigen::Matrix<Scalar, d, 2 * d> to_velocity;
-  to_velocity.template leftCols<d>() = -right_jacobian_inverse<G>(-fit.displacement);
-  to_velocity.template rightCols<d>() = right_jacobian_inverse<G>(fit.displacement);
+  to_velocity.template leftCols<d>() = -inverse_jacobian(-fit.displacement);
+  to_velocity.template rightCols<d>() = inverse_jacobian(fit.displacement);
   // L K^{-1} M K^{-T} L^T = (K^{-T} L^T)^T M (K^{-T} L^T).
   const Eigen::Matrix<Scalar, 2 * d, d> spread =
       transposed.solve(Eigen::Matrix<Scalar, 2 * d, d>(to_velocity.transpose()));
