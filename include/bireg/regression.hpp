@@ -121,96 +121,12 @@ class GeodesicRegression {
             first_bad};
   }
 
+  // The fit itself, defined below the class (not inline), so that an
+  // explicit instantiation declaration (bireg/precompiled.hpp) keeps a
+  // consumer from instantiating it again.
   template <class Observations, class Covariates>
   Result run(const Observations& observations, const Covariates& covariates,
-             const std::vector<Scalar>& weights, const Endpoints* start) const {
-    // 1. The problem, every input checked before any work.
-    if (auto rejection = validate_options(options_)) return rejected(*rejection);
-    const std::size_t n = observations.size();
-    if (covariates.size() != n) {
-      return rejected({"observations and covariates differ in length (" + std::to_string(n) +
-                       " vs " + std::to_string(covariates.size()) + ")"});
-    }
-    if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
-    Problem<Scalar> problem;
-    if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
-      return rejected(*rejection);
-    }
-    // The pool lives as long as this fit and serves every pass over the
-    // observations (parallel.hpp); below kParallelMinimum there is none.
-    std::optional<ChunkPool> pool;
-    if (options_.threads > 1 && n >= kParallelMinimum)
-      pool.emplace(options_.threads, chunk_count(n));
-    ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
-    if (auto rejection =
-            check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
-      return rejected(*rejection);
-    }
-    if (start && (!G::is_element(start->first, options_.element_tolerance) ||
-                  !G::is_element(start->second, options_.element_tolerance))) {
-      return rejected({std::string("the start is not a pair of elements of ") + G::name});
-    }
-
-    // 2. The start.
-    const ChartStart<G> chart = chart_start<G>(observations, problem, chunk_pool);
-    if (chart.no_logarithm >= 0) {
-      return rejected({"observation " + std::to_string(chart.no_logarithm) +
-                           " is out of reach of the middle observation: no principal logarithm "
-                           "of f_mid^{-1} f_i (the data leave the domain of " +
-                           G::name + "'s log)",
-                       chart.no_logarithm});
-    }
-    if (chart.too_large >= 0) {
-      return rejected({"observation " + std::to_string(chart.too_large) +
-                           " lies too far from the middle observation: log(f_mid^{-1} f_i) has "
-                           "coordinates above " +
-                           std::to_string(double(largest_tangent<Scalar>())) +
-                           ", whose squares the fit cannot sum in this scalar type",
-                       chart.too_large});
-    }
-    const Endpoints first = start ? *start : Endpoints(chart.g0, chart.g1);
-
-    // 3. The iteration, with the chosen step rule; 4. the diagnostics.
-    return with_step_rule<G>(options_.solver, [&](auto tag) {
-      using Rule = typename decltype(tag)::type;
-      if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
-      const Rule rule = make_rule<Rule>(problem, chunk_pool);
-      const PsiEvaluation psi = options_.psi();
-      const IterationControl<Scalar> control{options_.tolerance, options_.max_iterations,
-                                             options_.record_iterates};
-      Result result;
-      IterationRecord<G> record;
-      ForceWorkspace<G> workspace(chunk_pool, n);
-      const State<G> state =
-          iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
-                     chart.reference, result.residuals, record, &workspace);
-      // The estimating equations are not finite at the start nor at the
-      // middle observation: some residual log(g(t_i)^{-1} f_i) cannot be
-      // computed in this scalar type (a matrix observation too
-      // ill-conditioned to invert and take the log of, next to the
-      // others). There is no iterate to report, and no finite diagnostic.
-      if (state.series_converges && !state.usable()) {
-        return rejected(unevaluable_start(result.residuals));
-      }
-      if (!state.series_converges) {  // no force was evaluated there: residuals alone
-        const Element g0_inverse = G::inverse(state.g0);
-        for (std::size_t i = 0; i < n; ++i) {
-          result.residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
-        }
-      } else {
-        result.jacobian = jacobian_at(rule, problem, state);
-      }
-      result.status = record.status;
-      result.iterations = record.iterations;
-      result.diagnostics =
-          diagnose<G>(problem, rule, record, state, chart.spread, result.residuals, chunk_pool);
-      result.step_norms = std::move(record.step_norms);
-      result.iterates = std::move(record.iterates);
-      result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
-                                    static_cast<Scalar>(problem.t_max));
-      return result;
-    });
-  }
+             const std::vector<Scalar>& weights, const Endpoints* start) const;
 
   // The step rule for this fit; the Gauss-Newton rule sums its moments on
   // the pool.
@@ -238,4 +154,101 @@ class GeodesicRegression {
   Options options_;
 };
 
+template <class G>
+template <class Observations, class Covariates>
+typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
+    const Observations& observations, const Covariates& covariates,
+    const std::vector<Scalar>& weights, const Endpoints* start) const {
+  // 1. The problem, every input checked before any work.
+  if (auto rejection = validate_options(options_)) return rejected(*rejection);
+  const std::size_t n = observations.size();
+  if (covariates.size() != n) {
+    return rejected({"observations and covariates differ in length (" + std::to_string(n) + " vs " +
+                     std::to_string(covariates.size()) + ")"});
+  }
+  if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
+  Problem<Scalar> problem;
+  if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
+    return rejected(*rejection);
+  }
+  // The pool lives as long as this fit and serves every pass over the
+  // observations (parallel.hpp); below kParallelMinimum there is none.
+  std::optional<ChunkPool> pool;
+  if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads, chunk_count(n));
+  ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
+  if (auto rejection =
+          check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
+    return rejected(*rejection);
+  }
+  if (start && (!G::is_element(start->first, options_.element_tolerance) ||
+                !G::is_element(start->second, options_.element_tolerance))) {
+    return rejected({std::string("the start is not a pair of elements of ") + G::name});
+  }
+
+  // 2. The start.
+  const ChartStart<G> chart = chart_start<G>(observations, problem, chunk_pool);
+  if (chart.no_logarithm >= 0) {
+    return rejected({"observation " + std::to_string(chart.no_logarithm) +
+                         " is out of reach of the middle observation: no principal logarithm "
+                         "of f_mid^{-1} f_i (the data leave the domain of " +
+                         G::name + "'s log)",
+                     chart.no_logarithm});
+  }
+  if (chart.too_large >= 0) {
+    return rejected({"observation " + std::to_string(chart.too_large) +
+                         " lies too far from the middle observation: log(f_mid^{-1} f_i) has "
+                         "coordinates above " +
+                         std::to_string(double(largest_tangent<Scalar>())) +
+                         ", whose squares the fit cannot sum in this scalar type",
+                     chart.too_large});
+  }
+  const Endpoints first = start ? *start : Endpoints(chart.g0, chart.g1);
+
+  // 3. The iteration, with the chosen step rule; 4. the diagnostics.
+  return with_step_rule<G>(options_.solver, [&](auto tag) {
+    using Rule = typename decltype(tag)::type;
+    if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
+    const Rule rule = make_rule<Rule>(problem, chunk_pool);
+    const PsiEvaluation psi = options_.psi();
+    const IterationControl<Scalar> control{options_.tolerance, options_.max_iterations,
+                                           options_.record_iterates};
+    Result result;
+    IterationRecord<G> record;
+    ForceWorkspace<G> workspace(chunk_pool, n);
+    const State<G> state =
+        iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
+                   chart.reference, result.residuals, record, &workspace);
+    // The estimating equations are not finite at the start nor at the
+    // middle observation: some residual log(g(t_i)^{-1} f_i) cannot be
+    // computed in this scalar type (a matrix observation too
+    // ill-conditioned to invert and take the log of, next to the
+    // others). There is no iterate to report, and no finite diagnostic.
+    if (state.series_converges && !state.usable()) {
+      return rejected(unevaluable_start(result.residuals));
+    }
+    if (!state.series_converges) {  // no force was evaluated there: residuals alone
+      const Element g0_inverse = G::inverse(state.g0);
+      for (std::size_t i = 0; i < n; ++i) {
+        result.residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
+      }
+    } else {
+      result.jacobian = jacobian_at(rule, problem, state);
+    }
+    result.status = record.status;
+    result.iterations = record.iterations;
+    result.diagnostics =
+        diagnose<G>(problem, rule, record, state, chart.spread, result.residuals, chunk_pool);
+    result.step_norms = std::move(record.step_norms);
+    result.iterates = std::move(record.iterates);
+    result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
+                                  static_cast<Scalar>(problem.t_max));
+    return result;
+  });
+}
+
 }  // namespace bireg
+
+// The compiled part's instantiations of the fit (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/regression/precompiled.hpp"
+#endif

@@ -19,8 +19,12 @@ foreach(mode find_package subdirectory subdirectory_own_eigen)
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
     -DBIREG_CONSUMER_MODE=${mode}
     -DBIREG_SOURCE_DIR=${BIREG_SOURCE_DIR}
-    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+    -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
+    -DBIREG_CONSUMER_PRECOMPILED=${PRECOMPILED})
   run_step(${CMAKE_COMMAND} --build ${build})
   run_step(${build}/consumer)
+  if(PRECOMPILED AND mode STREQUAL "find_package")
+    run_step(${build}/consumer_precompiled)
+  endif()
   message(STATUS "consumer via ${mode}: ok")
 endforeach()

@@ -199,3 +199,9 @@ Eigen::Matrix<typename Matrix::Scalar, Matrix::RowsAtCompileTime, 1> half_widths
 }
 
 }  // namespace bireg
+
+// The compiled part's instantiations of the covariances and quantiles derived from a FitCovariance
+// (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/statistics/precompiled/confidence.hpp"
+#endif

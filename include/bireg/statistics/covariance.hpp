@@ -599,3 +599,9 @@ FitCovariance<G> covariance(const RegressionResult<G>& fit, const Covariates& co
 }
 
 }  // namespace bireg
+
+// The compiled part's instantiations of covariance() and covariance_of()
+// (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/statistics/precompiled/covariance.hpp"
+#endif

@@ -87,3 +87,8 @@ ExplainedVariance<typename G::Scalar> explained_variance(
 }
 
 }  // namespace bireg
+
+// The compiled part's instantiations of explained_variance() (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/statistics/precompiled/explained_variance.hpp"
+#endif

@@ -244,3 +244,8 @@ MeanResult<G> mean(const Observations& observations,
 }
 
 }  // namespace bireg
+
+// The compiled part's instantiations of mean() (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/statistics/precompiled/mean.hpp"
+#endif

@@ -363,3 +363,8 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
 }
 
 }  // namespace bireg
+
+// The compiled part's instantiations of trend_test() (bireg::bireg_precompiled).
+#if defined(BIREG_PRECOMPILED)
+#include "bireg/statistics/precompiled/trend_test.hpp"
+#endif
