@@ -3,11 +3,12 @@
 A Python face for the header-only C++ library of the same name: the
 groups with vectorised operations, ``GeodesicRegression`` and
 ``LocalRegression`` in scikit-learn's style, the bi-invariant ``mean``,
-and the trajectory readers. The README maps each name to its C++
-counterpart.
+the two-sample tests of cohorts, and the trajectory readers. The README
+maps each name to its C++ counterpart.
 """
 
 from ._bireg import __version__
+from .cohorts import ElementwiseResult, TwoSampleResult, two_sample_test
 from .groups import GLp3, SE2, SE3, SL3, SO2, SO3, Group, Sim3
 from .io import read_trajectory
 from .local import LocalRegression
@@ -16,4 +17,5 @@ from .regression import ConvergenceWarning, GeodesicRegression, mean
 __all__ = [
     "__version__", "Group", "SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3",
     "GeodesicRegression", "LocalRegression", "ConvergenceWarning", "mean", "read_trajectory",
+    "two_sample_test", "TwoSampleResult", "ElementwiseResult",
 ]

@@ -117,3 +117,13 @@ def select_bandwidth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape
 
 def read_trajectory(path: str, group: str, format: str, project: bool) -> dict:
     """bireg::io::read_trajectory<G>: t, Y, timestamps, lines, format."""
+
+def two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], statistic: str, variant: str, permutations: int, seed: int, threads: int) -> dict:
+    """
+    bireg::two_sample_test<G>: a dict with the statistic, p-value, means and covariances.
+    """
+
+def elementwise_two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_a: int, b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_b: int, elements: int, statistic: str, variant: str, permutations: int, seed: int, threads: int, mode: str) -> dict:
+    """
+    bireg::elementwise_two_sample_test<G>: per-element statistics, p-, q- and FWER p-values.
+    """

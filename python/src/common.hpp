@@ -170,5 +170,6 @@ void bind_groups(nb::module_& m);
 void bind_regression(nb::module_& m);
 void bind_statistics(nb::module_& m);
 void bind_io(nb::module_& m);
+void bind_cohorts(nb::module_& m);
 
 }  // namespace bireg_python

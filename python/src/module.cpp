@@ -1,5 +1,5 @@
 // The compiled part of the Python package bireg: one binding file per
-// layer of the library (groups, regression, statistics, io). The Python
+// layer of the library (groups, regression, statistics, io, cohorts). The Python
 // modules in python/bireg/ give it its scikit-learn-style face.
 #include "common.hpp"
 
@@ -12,4 +12,5 @@ NB_MODULE(_bireg, m) {
   bireg_python::bind_regression(m);
   bireg_python::bind_statistics(m);
   bireg_python::bind_io(m);
+  bireg_python::bind_cohorts(m);
 }

@@ -39,6 +39,16 @@ namespace bireg {
 
 enum class ElementwiseMode { exact, linearised };
 
+inline const char* to_string(ElementwiseMode mode) {
+  switch (mode) {
+    case ElementwiseMode::exact:
+      return "exact";
+    case ElementwiseMode::linearised:
+      return "linearised";
+  }
+  return "unknown";
+}
+
 template <class Scalar>
 struct ElementwiseOptions {
   TwoSampleOptions<Scalar> test;  // statistic, variant (exact mode), permutations, seed, threads
