@@ -122,8 +122,8 @@ class GeodesicRegression {
   }
 
   // The fit itself, defined below the class (not inline), so that an
-  // explicit instantiation declaration (bireg/precompiled.hpp) keeps a
-  // consumer from instantiating it again.
+  // explicit instantiation declaration (bireg/regression/precompiled.hpp)
+  // keeps a consumer from instantiating it again.
   template <class Observations, class Covariates>
   Result run(const Observations& observations, const Covariates& covariates,
              const std::vector<Scalar>& weights, const Endpoints* start) const;

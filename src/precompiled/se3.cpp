@@ -1,8 +1,8 @@
 // libbireg_precompiled: the explicit instantiation definitions for SE(3)
 // in double and float, one for each declaration in bireg/regression/
 // precompiled.hpp and bireg/statistics/precompiled/ (one file per group, so
-// that the library builds in parallel; tests/precompiled checks that the
-// declarations and these definitions are the same list).
+// that the library builds in parallel). tests/precompiled/check_lists.cmake
+// checks that the declarations and these definitions are the same list.
 #include <optional>
 #include <utility>
 #include <vector>
