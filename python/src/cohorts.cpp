@@ -58,14 +58,6 @@ nb::dict two_sample(const Stack& a, const Stack& b,
   return out;
 }
 
-template <class V>
-Output std_vector_array(const V& v) {
-  NewArray a({v.size()});
-  for (std::size_t k = 0; k < v.size(); ++k)
-    a.data()[k] = v[k];
-  return a.release();
-}
-
 // a: m subjects x K elements in one stack, subject i's element k at
 // i K + k (the layout of elementwise_two_sample_test); b likewise.
 template <class G>
@@ -82,10 +74,10 @@ nb::dict elementwise(const Stack& a, std::size_t m, const Stack& b, std::size_t 
   out["statistic"] = std::string(to_string(options.test.statistic));
   out["variant"] = std::string(to_string(options.test.variant));
   out["mode"] = std::string(to_string(options.mode));
-  out["value"] = std_vector_array(result.value);
-  out["p_value"] = std_vector_array(result.p_value);
-  out["q_value"] = std_vector_array(result.q_value);
-  out["p_fwer"] = std_vector_array(result.p_fwer);
+  out["value"] = vector_array(result.value);
+  out["p_value"] = vector_array(result.p_value);
+  out["q_value"] = vector_array(result.q_value);
+  out["p_fwer"] = vector_array(result.p_fwer);
   out["permutations"] = result.permutations;
   out["failed_permutations"] = result.failed_permutations;
   return out;

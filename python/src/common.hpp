@@ -148,11 +148,13 @@ Output matrix_array(const M& m) {
   return a.release();
 }
 
+// A vector as a 1-D array: an Eigen vector or a std::vector<double>.
 template <class V>
 Output vector_array(const V& v) {
-  NewArray a({std::size_t(v.size())});
-  for (Eigen::Index k = 0; k < v.size(); ++k)
-    a.data()[k] = v[k];
+  const std::size_t size = static_cast<std::size_t>(v.size());
+  NewArray a({size});
+  for (std::size_t k = 0; k < size; ++k)
+    a.data()[k] = v[static_cast<decltype(v.size())>(k)];
   return a.release();
 }
 

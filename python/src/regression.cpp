@@ -235,12 +235,7 @@ void bind_regression(nb::module_& m) {
       .def_prop_ro(
           "step_norms",
           [](const FitHandle& h) {
-            return on_fit(h, [](const auto& f) {
-              NewArray a({f.result.step_norms.size()});
-              for (std::size_t i = 0; i < f.result.step_norms.size(); ++i)
-                a.data()[i] = f.result.step_norms[i];
-              return a.release();
-            });
+            return on_fit(h, [](const auto& f) { return vector_array(f.result.step_norms); });
           },
           nb::rv_policy::move)
       .def_prop_ro("diagnostics",

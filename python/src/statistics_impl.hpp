@@ -233,15 +233,9 @@ nb::dict select_bandwidth(const Vector& t, const Stack& y,
   nb::dict out;
   out["bandwidth"] = s.bandwidth;
   out["velocity_bandwidth"] = s.velocity_bandwidth;
-  NewArray grid({s.grid.size()}), criterion({s.grid.size()}), velocity({s.grid.size()});
-  for (std::size_t k = 0; k < s.grid.size(); ++k) {
-    grid.data()[k] = s.grid[k];
-    criterion.data()[k] = s.criterion[k];
-    velocity.data()[k] = s.velocity_criterion[k];
-  }
-  out["grid"] = grid.release();
-  out["criterion"] = criterion.release();
-  out["velocity_criterion"] = velocity.release();
+  out["grid"] = vector_array(s.grid);
+  out["criterion"] = vector_array(s.criterion);
+  out["velocity_criterion"] = vector_array(s.velocity_criterion);
   out["message"] = s.message;
   return out;
 }
