@@ -194,6 +194,66 @@ TEST_CASE("Benjamini-Hochberg controls the FDR and max-T the family-wise error",
   CHECK(true_found >= 0.5 * kShifted * kStudies);
 }
 
+// A map of 37 elements computed as slices 0-9, 10-29 and 30-36 (each with
+// all relabellings) and joined by combine_elementwise equals the map of all
+// 37 at once: the per-element p-values are the slices' own, and the
+// family-wise p-values and q-values need every element, which the slices'
+// per-relabelling maxima and ranked values carry.
+TEST_CASE("An element-wise map computed in slices of elements combines exactly",
+          "[cohorts][maps][shares]") {
+  std::mt19937 rng(21);
+  const int m = 9, n = 10, elements = 37;
+  const auto a = cohort(rng, m, elements, 0.2, 0, SO3::Tangent::Zero());
+  const auto b = cohort(rng, n, elements, 0.2, 6, SO3::Tangent(0.25, 0, 0));
+  for (const auto mode : {bireg::ElementwiseMode::linearised, bireg::ElementwiseMode::exact}) {
+    auto options = options_for(mode, 199);
+    options.test.statistic = bireg::TwoSampleStatistic::hellinger;
+    const auto whole = bireg::elementwise_two_sample_test<bireg::SO3d>(
+        a, std::size_t(m), b, std::size_t(n), std::size_t(elements), options);
+    REQUIRE(whole.ok());
+    const auto slice = [&](int first, int count) {
+      std::vector<SO3::Element> slice_a, slice_b;
+      for (int i = 0; i < m; ++i)
+        for (int k = first; k < first + count; ++k)
+          slice_a.push_back(a[std::size_t(i * elements + k)]);
+      for (int j = 0; j < n; ++j)
+        for (int k = first; k < first + count; ++k)
+          slice_b.push_back(b[std::size_t(j * elements + k)]);
+      return bireg::elementwise_two_sample_test<bireg::SO3d>(
+          slice_a, std::size_t(m), slice_b, std::size_t(n), std::size_t(count), options);
+    };
+    const auto combined =
+        bireg::combine_elementwise<bireg::SO3d>({slice(0, 10), slice(10, 20), slice(30, 7)});
+    REQUIRE(combined.ok());
+    REQUIRE(combined.elements == std::size_t(elements));
+    CHECK(combined.value == whole.value);
+    CHECK(combined.p_value == whole.p_value);
+    CHECK(combined.p_fwer == whole.p_fwer);
+    CHECK(combined.q_value == whole.q_value);
+    // The shifted elements make the adjustment matter: some family-wise
+    // p-value is above its element's p-value (else joining could skip it).
+    bool adjusted = false;
+    for (int k = 0; k < elements; ++k)
+      adjusted = adjusted || whole.p_fwer[std::size_t(k)] > whole.p_value[std::size_t(k)];
+    CHECK(adjusted);
+    // The family-wise p-values by their definition, counted by hand.
+    REQUIRE(whole.relabelling_maximum.size() == 199);
+    for (int k = 0; k < elements; ++k) {
+      const double threshold = whole.ranked_value[std::size_t(k)] * (1 - 1e-9);
+      int beyond = 0;
+      for (const double maximum : whole.relabelling_maximum)
+        beyond += maximum >= threshold ? 1 : 0;
+      CHECK(whole.p_fwer[std::size_t(k)] == (1.0 + beyond) / 200.0);
+    }
+    // Slices of other relabellings do not join.
+    auto fewer = options;
+    fewer.test.permutations = 99;
+    const auto other = bireg::elementwise_two_sample_test<bireg::SO3d>(
+        a, std::size_t(m), b, std::size_t(n), std::size_t(elements), fewer);
+    CHECK(!bireg::combine_elementwise<bireg::SO3d>({slice(0, 10), other}).ok());
+  }
+}
+
 TEST_CASE("Element-wise maps refuse bad input and name the element", "[cohorts][maps][hostile]") {
   std::mt19937 rng(5);
   auto a = cohort(rng, 6, 3, 0.3, 0, SO3::Tangent::Zero());
@@ -215,4 +275,10 @@ TEST_CASE("Element-wise maps refuse bad input and name the element", "[cohorts][
   CHECK_FALSE(with_nan.ok());
   CHECK(with_nan.bad_element == 2);
   CHECK(with_nan.message.find("element 2") != std::string::npos);
+  // A slice of a larger map names the element by its index in the map.
+  auto slice = options;
+  slice.first_element = 30;
+  const auto in_slice = bireg::elementwise_two_sample_test<SO3>(a, 6, b, 6, 3, slice);
+  CHECK(in_slice.bad_element == 32);
+  CHECK(in_slice.message.find("element 32:") != std::string::npos);
 }

@@ -112,6 +112,11 @@ TEST_CASE("fit_many reports each failed subject and refuses a bad interval",
   CHECK(fits.fits[0].ok());
   CHECK(fits.fits[3].ok());
   CHECK_FALSE(fits.fits[2].ok());
+  // A block of a larger cohort names the subject by its cohort index.
+  bireg::FitManyOptions<double> block;
+  block.first_subject = 40;
+  const auto in_block = bireg::fit_many(bireg::GeodesicRegression<SO3>(), subjects, block);
+  CHECK(in_block.message.find("subject 42:") != std::string::npos);
   bireg::FitManyOptions<double> reversed;
   reversed.t0 = 1.0;
   reversed.t1 = 0.0;

@@ -5,6 +5,7 @@
 // and refusals.
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <string>
@@ -219,6 +220,58 @@ TEST_CASE("The p-value does not depend on the thread count", "[cohorts][threads]
   CHECK(serial.p_value == parallel.p_value);
   // The observed split is among the relabellings' outcomes: p >= 1 / (B + 1).
   CHECK(serial.p_value >= 1.0 / 334);
+}
+
+// A test shared out as relabellings 0-99, 100-249 and 250-332, given to
+// combine_two_sample in a shuffled order, is the whole test: the same
+// relabellings (permutation.hpp derives each from (seed, b)), so the same
+// integer counts and p. A gap, an overlap, other data or a failed share is
+// refused.
+TEST_CASE("A test shared out in relabelling blocks combines to the whole test",
+          "[cohorts][shares]") {
+  using G = bireg::SO3d;
+  std::mt19937 rng(14);
+  const auto a = sample<G>(rng, G::identity(), 11, 0.4);
+  const auto b = sample<G>(rng, G::exp(G::Tangent(0.15, 0, 0)), 13, 0.4);
+  for (const TwoSampleStatistic statistic : kStatistics) {
+    const auto options = options_for(statistic, 333);
+    const auto whole = bireg::two_sample_test<G>(a, b, options);
+    REQUIRE(whole.ok());
+    // Neither p = 1 / (B + 1) nor p = 1: a count a wrong block could move.
+    REQUIRE(whole.at_least_as_extreme > 0);
+    REQUIRE(whole.at_least_as_extreme < 333);
+    const auto share = [&](std::uint64_t first, int count, std::vector<G::Element> data_b) {
+      auto part = options;
+      part.first_permutation = first;
+      part.permutations = count;
+      return bireg::two_sample_test<G>(a, data_b, part);
+    };
+    const std::vector<bireg::TwoSampleResult<G>> shares = {share(250, 83, b), share(0, 100, b),
+                                                           share(100, 150, b)};
+    const auto combined = bireg::combine_two_sample(shares);
+    REQUIRE(combined.ok());
+    CHECK(combined.permutations == 333);
+    CHECK(combined.at_least_as_extreme == whole.at_least_as_extreme);
+    CHECK(combined.p_value == whole.p_value);
+    CHECK(combined.value == whole.value);
+    // Shares that would be wrong, each refused with its reason.
+    const auto gap = bireg::combine_two_sample<G>({shares[1], shares[0]});
+    CHECK(!gap.ok());
+    CHECK(gap.message.find("do not tile") != std::string::npos);
+    const auto overlap = bireg::combine_two_sample<G>({shares[1], share(50, 200, b), shares[0]});
+    CHECK(!overlap.ok());
+    auto moved = b;
+    moved[0] = G::compose(G::exp(G::Tangent(0, 0.3, 0)), moved[0]);
+    const auto other = bireg::combine_two_sample<G>({shares[1], share(100, 233, moved)});
+    CHECK(!other.ok());
+    CHECK(other.message.find("different data") != std::string::npos);
+    CHECK(!bireg::combine_two_sample<G>({}).ok());
+  }
+  auto too_far = options_for(TwoSampleStatistic::hotelling, 10);
+  too_far.first_permutation = bireg::kMaxTwoSamplePermutations - 5;
+  const auto refused = bireg::two_sample_test<G>(a, b, too_far);
+  CHECK(!refused.ok());
+  CHECK(refused.message.find("first_permutation + permutations") != std::string::npos);
 }
 
 namespace {

@@ -154,8 +154,8 @@ MUTANTS = [
            ["test_cohorts"],
            "parallel transport from m_B to m_A with the wrong sign, Ad(exp(-c/2))"),
     Mutant("CO2", "include/bireg/statistics/cohorts/two_sample.hpp",
-           "result.p_value = Scalar(1 + result.at_least_as_extreme) / Scalar(1 + options.permutations);",
-           "result.p_value = Scalar(result.at_least_as_extreme) / Scalar(1 + options.permutations);",
+           "return Scalar(1 + at_least_as_extreme) / Scalar(1 + permutations);",
+           "return Scalar(at_least_as_extreme) / Scalar(1 + permutations);",
            ["test_cohorts"],
            "the invalid permutation p-value #{T_b >= T} / (B + 1), which can be 0"),
     Mutant("CO3", "include/bireg/statistics/cohorts/elementwise.hpp",
@@ -163,6 +163,16 @@ MUTANTS = [
            "const Scalar candidate = p[order[r]] * Scalar(k) / Scalar(k);",
            ["test_cohort_maps"],
            "Benjamini-Hochberg without the rank (Bonferroni's K p instead)"),
+    Mutant("CO4", "include/bireg/statistics/cohorts/two_sample.hpp",
+           "permutation(options.seed, options.first_permutation + b, m + n, order);",
+           "permutation(options.seed, b, m + n, order);",
+           ["test_cohorts"],
+           "every share of a test runs the first relabellings, not its own"),
+    Mutant("CO5", "include/bireg/statistics/cohorts/elementwise.hpp",
+           "std::max(result.relabelling_maximum[r], slice.relabelling_maximum[r]);",
+           "std::min(result.relabelling_maximum[r], slice.relabelling_maximum[r]);",
+           ["test_cohort_maps"],
+           "joined slices keep the smallest maximum: family-wise p-values too small"),
 ]
 
 

@@ -8,7 +8,8 @@ maps each name to its C++ counterpart.
 """
 
 from ._bireg import __version__
-from .cohorts import ElementwiseResult, TwoSampleResult, two_sample_test
+from .cohorts import (ElementwiseResult, FitManyResult, PopulationTrend, TwoSampleResult,
+                      compare_trends, fit_many, population_trend, two_sample_test)
 from .groups import GLp3, SE2, SE3, SL3, SO2, SO3, Group, Sim3
 from .io import read_trajectory
 from .local import LocalRegression
@@ -17,5 +18,6 @@ from .regression import ConvergenceWarning, GeodesicRegression, mean
 __all__ = [
     "__version__", "Group", "SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3",
     "GeodesicRegression", "LocalRegression", "ConvergenceWarning", "mean", "read_trajectory",
-    "two_sample_test", "TwoSampleResult", "ElementwiseResult",
+    "two_sample_test", "TwoSampleResult", "ElementwiseResult", "fit_many", "FitManyResult",
+    "compare_trends", "population_trend", "PopulationTrend",
 ]

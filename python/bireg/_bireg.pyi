@@ -1,5 +1,6 @@
 """bireg's compiled core: bi-invariant regression on Lie groups"""
 
+from collections.abc import Sequence
 from typing import Annotated
 
 import numpy
@@ -118,12 +119,37 @@ def select_bandwidth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape
 def read_trajectory(path: str, group: str, format: str, project: bool) -> dict:
     """bireg::io::read_trajectory<G>: t, Y, timestamps, lines, format."""
 
-def two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], statistic: str, variant: str, permutations: int, seed: int, threads: int) -> dict:
+def two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], statistic: str, variant: str, permutations: int, seed: int, threads: int, first_permutation: int = 0) -> dict:
     """
-    bireg::two_sample_test<G>: a dict with the statistic, p-value, means and covariances.
+    bireg::two_sample_test<G>: a dict with the statistic, p-value, means and covariances; relabellings first_permutation .. first_permutation + permutations - 1.
     """
 
-def elementwise_two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_a: int, b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_b: int, elements: int, statistic: str, variant: str, permutations: int, seed: int, threads: int, mode: str) -> dict:
+def combine_two_sample(group: str, shares: Sequence[dict]) -> dict:
+    """
+    bireg::combine_two_sample<G>: one test from two_sample_test's shares of its relabellings.
+    """
+
+def combine_elementwise(group: str, slices: Sequence[dict]) -> dict:
+    """
+    bireg::combine_elementwise<G>: one map from the maps of consecutive slices of the elements.
+    """
+
+def elementwise_two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_a: int, b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], subjects_b: int, elements: int, statistic: str, variant: str, permutations: int, seed: int, threads: int, mode: str, first_element: int = 0) -> dict:
     """
     bireg::elementwise_two_sample_test<G>: per-element statistics, p-, q- and FWER p-values.
+    """
+
+def fit_many(group: str, t: Sequence[Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]], y: Sequence[Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]], t0: float, t1: float, threads: int, first_subject: int = 0) -> dict:
+    """
+    bireg::fit_many<G>: every subject's trend (gamma(t0), gamma(t1)) on one interval.
+    """
+
+def compare_trends(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], statistic: str, variant: str, permutations: int, seed: int, threads: int, first_permutation: int = 0) -> dict:
+    """
+    bireg::compare_trends<G>: the two-sample test of two cohorts' trends in G x G.
+    """
+
+def population_trend(group: str, trends: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], t0: float, t1: float, level: float, outlier_level: float) -> dict:
+    """
+    bireg::population_trend<G>: the mean trend, its confidence region, outlying subjects.
     """

@@ -4,8 +4,10 @@ the element-wise map (bireg/statistics/cohorts/, docs/cohorts.md).
 ``two_sample_test(A, B, group=...)`` calls ``bireg::two_sample_test<G>`` on
 two samples of shape (m, n, n) and (k, n, n), or
 ``bireg::elementwise_two_sample_test<G>`` on subjects of K elements each,
-(m, K, n, n) and (k, K, n, n). p-values come from seeded relabellings and
-do not depend on ``threads``.
+(m, K, n, n) and (k, K, n, n). ``fit_many`` fits each subject's geodesic
+and evaluates it on one shared interval, ``compare_trends`` tests two
+cohorts' trends in G x G, ``population_trend`` pools them. p-values come
+from seeded relabellings and do not depend on ``threads``.
 """
 
 from dataclasses import dataclass
@@ -61,19 +63,45 @@ class ElementwiseResult:
     failed_permutations: int
 
 
-def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", permutations=9999,
-                    seed=0, threads=1, mode="exact"):
-    """The bi-invariant two-sample test of A against B.
+@dataclass(frozen=True)
+class _TestPlan:
+    """two_sample_test's arguments, checked and converted once: what a share
+    of the test (bireg.dask) needs to run on a worker."""
 
-    A (m, n, n) and B (k, n, n): a ``TwoSampleResult``. A (m, K, n, n) and
-    B (k, K, n, n), K elements per subject (a shape's per-triangle
-    deformation gradients, a skeleton's joint rotations): an
-    ``ElementwiseResult``, with ``mode`` exact (means recomputed per
-    relabelling) or linearised (coordinates at each element's pooled mean).
-    ``statistic`` is hotelling, bhattacharyya or hellinger; ``variant``
-    invariant (also under inversion) or published. Raises ValueError for
-    invalid input, naming the sample and element.
-    """
+    group: str
+    a: np.ndarray          # (m, n, n), or (m K, n, n) for a map
+    b: np.ndarray
+    elements: int          # 0: a test of elements; K: a map
+    statistic: str
+    variant: str
+    permutations: int
+    seed: int
+    threads: int
+    mode: str
+
+    def run_test(self, first_permutation=0, permutations=None):
+        """The dict of bireg::two_sample_test on relabellings
+        first_permutation .. + permutations - 1 (all by default)."""
+        count = self.permutations if permutations is None else permutations
+        return _bireg.two_sample_test(self.group, self.a, self.b, self.statistic, self.variant,
+                                      count, self.seed, self.threads, first_permutation)
+
+    def run_map(self, first_element=0, elements=None):
+        """The dict of bireg::elementwise_two_sample_test on elements
+        first_element .. + elements - 1 (all by default)."""
+        K = self.elements
+        count = K - first_element if elements is None else elements
+        n = self.a.shape[-1]
+        a = self.a.reshape(-1, K, n, n)[:, first_element:first_element + count]
+        b = self.b.reshape(-1, K, n, n)[:, first_element:first_element + count]
+        m, k = a.shape[0], b.shape[0]
+        return _bireg.elementwise_two_sample_test(
+            self.group, np.ascontiguousarray(a).reshape(m * count, n, n), m,
+            np.ascontiguousarray(b).reshape(k * count, n, n), k, count, self.statistic,
+            self.variant, self.permutations, self.seed, self.threads, self.mode, first_element)
+
+
+def _plan(A, B, group, statistic, variant, permutations, seed, threads, mode):
     g = _groups.get(group)
     n = g.matrix_size
     a = np.ascontiguousarray(A, dtype=np.float64)
@@ -89,9 +117,7 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
         if mode != "exact":
             raise ValueError(f"mode {mode!r} applies to element-wise maps only ((m, K, {n}, {n}) "
                              "arrays); a test of two samples of elements is exact")
-        out = _bireg.two_sample_test(g.name, a, b, statistic, variant, permutations, seed,
-                                     threads)
-        return TwoSampleResult(**out)
+        return _TestPlan(g.name, a, b, 0, statistic, variant, permutations, seed, threads, mode)
     if a.ndim == 4 and b.ndim == 4:
         if a.shape[2:] != (n, n) or b.shape[2:] != (n, n):
             raise ValueError(f"A and B must have shape (m, K, {n}, {n}) and (k, K, {n}, {n}), "
@@ -100,9 +126,183 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
             raise ValueError(f"A and B differ in K, the elements per subject ({a.shape[1]} vs "
                              f"{b.shape[1]})")
         m, elements, k = a.shape[0], a.shape[1], b.shape[0]
-        out = _bireg.elementwise_two_sample_test(
-            g.name, a.reshape(m * elements, n, n), m, b.reshape(k * elements, n, n), k, elements,
-            statistic, variant, permutations, seed, threads, mode)
-        return ElementwiseResult(**out)
+        if elements == 0:
+            raise ValueError("K, the number of elements per subject, must be at least 1")
+        return _TestPlan(g.name, a.reshape(m * elements, n, n), b.reshape(k * elements, n, n),
+                         elements, statistic, variant, permutations, seed, threads, mode)
     raise ValueError(f"A and B must both have shape (m, {n}, {n}) or both (m, K, {n}, {n}), got "
                      f"{a.shape} and {b.shape}")
+
+
+def _test_result(out):
+    """A TwoSampleResult from the binding's dict (which also says which
+    relabellings it ran, for joining shares)."""
+    return TwoSampleResult(**{k: v for k, v in out.items() if k != "first_permutation"})
+
+
+def _map_result(out):
+    """An ElementwiseResult from the binding's dict (which also carries the
+    per-relabelling maxima, for joining slices)."""
+    internal = ("ranked_value", "relabelling_maximum")
+    return ElementwiseResult(**{k: v for k, v in out.items() if k not in internal})
+
+
+def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", permutations=9999,
+                    seed=0, threads=1, mode="exact"):
+    """The bi-invariant two-sample test of A against B.
+
+    A (m, n, n) and B (k, n, n): a ``TwoSampleResult``. A (m, K, n, n) and
+    B (k, K, n, n), K elements per subject (a shape's per-triangle
+    deformation gradients, a skeleton's joint rotations): an
+    ``ElementwiseResult``, with ``mode`` exact (means recomputed per
+    relabelling) or linearised (coordinates at each element's pooled mean).
+    ``statistic`` is hotelling, bhattacharyya or hellinger; ``variant``
+    invariant (also under inversion) or published. Raises ValueError for
+    invalid input, naming the sample and element. ``bireg.dask`` runs the
+    same test on a cluster with the same result.
+    """
+    plan = _plan(A, B, group, statistic, variant, permutations, seed, threads, mode)
+    if plan.elements == 0:
+        return _test_result(plan.run_test())
+    return _map_result(plan.run_map())
+
+
+# ---- trends: one geodesic per subject, compared and pooled -------------------
+
+@dataclass(frozen=True)
+class FitManyResult:
+    """Every subject's trend (gamma(t0), gamma(t1)) on the shared interval
+    (``bireg::FitManyResult``): ``trends`` is (S, 2, n, n), ``n_iter`` the
+    iterations of each subject's fit."""
+
+    t0: float
+    t1: float
+    trends: np.ndarray
+    n_iter: np.ndarray
+
+
+@dataclass(frozen=True)
+class PopulationTrend:
+    """The two-stage population trend (``bireg::PopulationTrend``): the
+    bi-invariant ``mean`` of the trends in G x G, (2, n, n); ``covariance``
+    S of the subjects about it and ``mean_covariance`` S / N for N subjects
+    (2d x 2d, G's coordinates at t0 first); the confidence region is the
+    trends mean exp(delta) with N delta^T S^-1 delta <= ``radius_squared``; the
+    population's body ``velocity`` per covariate unit with its covariance;
+    per subject, ``mahalanobis_squared`` and ``outlying`` (above
+    ``outlier_threshold``)."""
+
+    mean: np.ndarray
+    covariance: np.ndarray
+    mean_covariance: np.ndarray
+    radius_squared: float
+    velocity: np.ndarray
+    velocity_covariance: np.ndarray
+    mahalanobis_squared: np.ndarray
+    outlying: np.ndarray
+    outlier_threshold: float
+
+
+def _trends(trends, n, name):
+    a = np.ascontiguousarray(trends, dtype=np.float64)
+    if a.ndim != 4 or a.shape[1:] != (2, n, n):
+        raise ValueError(f"{name} must have shape (S, 2, {n}, {n}) (fit_many's trends), "
+                         f"got {a.shape}")
+    return a
+
+
+def _subject_arrays(subjects, g, first_subject=0):
+    """Each subject's (t, Y) as the binding's arrays, named by cohort index."""
+    t_list, y_list = [], []
+    for i, subject in enumerate(subjects, start=first_subject):
+        try:
+            t, Y = subject
+        except (TypeError, ValueError):
+            raise ValueError(f"subject {i} must be a pair (t, Y)") from None
+        t_list.append(_arrays.covariates(t, f"subject {i}'s t"))
+        y_list.append(_arrays.matrices(Y, g.matrix_size, f"subject {i}'s Y"))
+    return t_list, y_list
+
+
+def _fit_block(subjects, group, t0, t1, threads, first_subject=0):
+    """The binding's fit_many on one block of a cohort, whose first subject
+    is subject ``first_subject`` of the cohort (for messages)."""
+    g = _groups.get(group)
+    t_list, y_list = _subject_arrays(subjects, g, first_subject)
+    out = _bireg.fit_many(g.name, t_list, y_list, t0, t1, threads, first_subject)
+    out["n_iter"] = out["n_iter"].astype(np.int64)
+    return out
+
+
+def _interval(interval):
+    if interval is None:
+        return float("nan"), float("nan")
+    t0, t1 = (float(v) for v in interval)
+    return t0, t1
+
+
+def fit_many(subjects, group, interval=None, threads=1):
+    """Fits one geodesic per subject, each a pair (t, Y) of shapes (N_i,)
+    and (N_i, n, n), and evaluates it at the ends of one shared interval
+    (``interval``, or from the smallest to the largest covariate of all
+    subjects): a trend's ends are comparable between subjects only on one
+    interval. Raises ValueError if any subject's fit fails, naming the
+    first (no trend is returned for a fit that did not succeed). The
+    Python module has trends for SO3 and SE3.
+    """
+    t0, t1 = _interval(interval)
+    threads = _arrays.positive_int(threads, "threads")
+    return FitManyResult(**_fit_block(subjects, group, t0, t1, threads))
+
+
+@dataclass(frozen=True)
+class _TrendPlan:
+    """compare_trends' arguments, checked once; ``run`` runs a share of the
+    relabellings (bireg.dask)."""
+
+    group: str
+    a: np.ndarray
+    b: np.ndarray
+    statistic: str
+    variant: str
+    permutations: int
+    seed: int
+    threads: int
+
+    def run(self, first_permutation=0, permutations=None):
+        count = self.permutations if permutations is None else permutations
+        return _bireg.compare_trends(self.group, self.a, self.b, self.statistic, self.variant,
+                                     count, self.seed, self.threads, first_permutation)
+
+
+def _trend_plan(trends_a, trends_b, group, statistic, variant, permutations, seed, threads):
+    g = _groups.get(group)
+    seed = _arrays.positive_int(seed, "seed")
+    if seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    return _TrendPlan(g.name, _trends(trends_a, g.matrix_size, "trends_a"),
+                      _trends(trends_b, g.matrix_size, "trends_b"), statistic, variant,
+                      _arrays.positive_int(permutations, "permutations"), seed,
+                      _arrays.positive_int(threads, "threads"))
+
+
+def compare_trends(trends_a, trends_b, group, statistic="hotelling", variant="invariant",
+                   permutations=9999, seed=0, threads=1):
+    """The two-sample test of two cohorts' trends ((m, 2, n, n) and
+    (k, 2, n, n), fit_many's ``trends`` on one interval) in G x G
+    (``bireg::compare_trends``): a ``TwoSampleResult`` whose means are
+    (2, n, n) and whose coordinates are 2d long."""
+    plan = _trend_plan(trends_a, trends_b, group, statistic, variant, permutations, seed, threads)
+    return _test_result(plan.run())
+
+
+def population_trend(trends, interval, group, level=0.95, outlier_level=0.999):
+    """The population trend of subjects' trends (S, 2, n, n) on ``interval``
+    = (t0, t1), fit_many's (``bireg::population_trend``): a
+    ``PopulationTrend``. Needs more than 2d + 1 subjects."""
+    g = _groups.get(group)
+    a = _trends(trends, g.matrix_size, "trends")
+    t0, t1 = (float(v) for v in interval)
+    out = _bireg.population_trend(g.name, a, t0, t1, float(level), float(outlier_level))
+    out["outlying"] = out["outlying"].astype(bool)
+    return PopulationTrend(**out)

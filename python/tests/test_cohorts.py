@@ -235,3 +235,127 @@ def test_bad_data_are_value_errors_naming_the_element(rng):
                               statistic="bhattacharyya")
     with pytest.raises(ValueError, match="unknown group"):
         bireg.two_sample_test(a, b, group="SO4")
+
+
+# ---- trends -------------------------------------------------------------------
+
+def block_diagonal(trends):
+    """(S, 2, n, n) -> (S, 2n, 2n): G x G as block-diagonal matrices, whose
+    exp, log and means are the factors' (the independent implementation
+    above then works on G x G unchanged)."""
+    count, _, n, _ = trends.shape
+    out = np.zeros((count, 2 * n, 2 * n))
+    out[:, :n, :n] = trends[:, 0]
+    out[:, n:, n:] = trends[:, 1]
+    return out
+
+
+def product_basis(group):
+    basis = algebra_basis(group)
+    n = basis[0].shape[0]
+    out = []
+    for b in basis:
+        for block in range(2):
+            x = np.zeros((2 * n, 2 * n))
+            x[block * n:(block + 1) * n, block * n:(block + 1) * n] = b
+            out.append(x)
+    return out
+
+
+def subjects_about(start, velocity, count, rng, spread=0.05, noise=0.02, shift=None):
+    """count subjects of 8 observations on t in [0, 1], each about the
+    geodesic start exp(t velocity) moved by its own deviation."""
+    g = bireg.SO3
+    out = []
+    for _ in range(count):
+        own_start = g.compose(start, g.exp(spread * rng.standard_normal(3)))
+        own_velocity = velocity + spread * rng.standard_normal(3)
+        t = np.sort(rng.uniform(0, 1, 8))
+        Y = g.compose(own_start, g.exp(t[:, None] * own_velocity))
+        out.append((t, g.compose(Y, g.exp(noise * rng.standard_normal((8, 3))))))
+    return out
+
+
+def test_fit_many_evaluates_each_fit_on_the_shared_interval(rng):
+    g = bireg.SO3
+    start, velocity = g.exp(np.array([0.2, -0.1, 0.3])), np.array([0.5, 0.2, -0.4])
+    subjects = subjects_about(start, velocity, 7, rng)
+    result = bireg.fit_many(subjects, group="SO3", interval=(0.0, 1.0), threads=2)
+    assert result.trends.shape == (7, 2, 3, 3) and (result.t0, result.t1) == (0.0, 1.0)
+    for (t, Y), trend in zip(subjects, result.trends):
+        alone = bireg.GeodesicRegression(group="SO3").fit(t, Y)
+        assert np.allclose(trend, alone.predict([0.0, 1.0]), atol=1e-12)
+    # Noise-free subjects on one geodesic: the trends are its ends.
+    exact = subjects_about(start, velocity, 3, rng, spread=0.0, noise=0.0)
+    ends = bireg.fit_many(exact, group="SO3", interval=(-1.0, 2.0)).trends
+    for trend in ends:
+        assert np.allclose(trend, g.compose(start, g.exp(np.outer([-1.0, 2.0], velocity))),
+                           atol=1e-10)
+    # The default interval: the smallest to the largest covariate of all.
+    default = bireg.fit_many(subjects, group="SO3")
+    everything = np.concatenate([t for t, _ in subjects])
+    assert (default.t0, default.t1) == (everything.min(), everything.max())
+
+
+def test_fit_many_refuses_when_a_subject_fails(rng):
+    subjects = subjects_about(np.eye(3), np.array([0.3, 0.0, 0.0]), 4, rng)
+    t, Y = subjects[2]
+    Y = Y.copy()
+    Y[5, 1, 1] = np.nan
+    subjects[2] = (t, Y)
+    with pytest.raises(ValueError, match="subject 2.*observation 5"):
+        bireg.fit_many(subjects, group="SO3")
+    with pytest.raises(ValueError, match="pair"):
+        bireg.fit_many([np.zeros(3)], group="SO3")
+    with pytest.raises(ValueError, match="t0 < t1"):
+        bireg.fit_many(subjects[:2], group="SO3", interval=(1.0, 0.0))
+
+
+def test_compare_trends_equals_the_test_on_block_diagonal_pairs(rng):
+    start = bireg.SO3.exp(np.array([0.1, 0.2, -0.3]))
+    a = bireg.fit_many(subjects_about(start, np.array([0.4, 0.0, 0.1]), 16, rng), group="SO3",
+                       interval=(0.0, 1.0)).trends
+    b = bireg.fit_many(subjects_about(start, np.array([0.4, 0.2, 0.1]), 18, rng), group="SO3",
+                       interval=(0.0, 1.0)).trends
+    result = bireg.compare_trends(a, b, group="SO3", permutations=999, seed=5)
+    assert result.mean_a.shape == (2, 3, 3) and result.covariance_a.shape == (6, 6)
+    # The same statistic computed from scratch on G x G as block-diagonal matrices.
+    basis = product_basis("SO3")
+    pa, pb = block_diagonal(a), block_diagonal(b)
+    m_a, m_b = group_mean(pa), group_mean(pb)
+    x_a = np.array([coordinates(log(np.linalg.solve(m_a, f)), basis) for f in pa])
+    x_b = np.array([coordinates(log(np.linalg.solve(m_b, f)), basis) for f in pb])
+    c_matrix = log(np.linalg.solve(m_a, m_b))
+    c = coordinates(c_matrix, basis)
+    transport = adjoint(linalg.expm(c_matrix / 2), basis)
+    s_b = transport @ (x_b.T @ x_b / len(pb)) @ transport.T
+    pooled = (x_a.T @ x_a + len(pb) * s_b) / (len(pa) + len(pb) - 2)
+    t2 = len(pa) * len(pb) / (len(pa) + len(pb)) * c @ np.linalg.solve(pooled, c)
+    assert result.value == pytest.approx(t2, rel=1e-10)
+    # A velocity that differs by 0.2 rad/unit, four between-subject
+    # standard deviations: detected.
+    assert result.p_value <= 0.01
+    same = bireg.compare_trends(a[:8], a[8:], group="SO3", permutations=999, seed=5)
+    assert same.p_value > 0.01
+
+
+def test_population_trend_against_its_definition(rng):
+    start, velocity = bireg.SO3.exp(np.array([0.3, 0.0, 0.1])), np.array([0.2, -0.3, 0.5])
+    trends = bireg.fit_many(subjects_about(start, velocity, 30, rng), group="SO3",
+                            interval=(0.0, 2.0)).trends
+    population = bireg.population_trend(trends, (0.0, 2.0), group="SO3")
+    basis = product_basis("SO3")
+    pairs = block_diagonal(trends)
+    mean = group_mean(pairs)
+    assert np.allclose(block_diagonal(population.mean[None])[0], mean, atol=1e-12)
+    y = np.array([coordinates(log(np.linalg.solve(mean, f)), basis) for f in pairs])
+    s = y.T @ y / (len(pairs) - 1)
+    # Coordinates here interleave the factors; the Mahalanobis distances do
+    # not depend on the basis.
+    distances = np.einsum("ij,ij->i", y, np.linalg.solve(s, y.T).T)
+    assert np.allclose(population.mahalanobis_squared, distances, rtol=1e-9)
+    m0, m1 = population.mean
+    assert np.allclose(population.velocity, bireg.SO3.log(m0.T @ m1) / 2.0, atol=1e-12)
+    assert population.outlying.dtype == bool and population.outlying.shape == (30,)
+    with pytest.raises(ValueError, match="population_trend"):
+        bireg.population_trend(trends[:5], (0.0, 2.0), group="SO3")

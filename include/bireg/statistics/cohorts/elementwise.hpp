@@ -25,6 +25,7 @@
 #include <limits>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -53,6 +54,9 @@ template <class Scalar>
 struct ElementwiseOptions {
   TwoSampleOptions<Scalar> test;  // statistic, variant (exact mode), permutations, seed, threads
   ElementwiseMode mode = ElementwiseMode::linearised;
+  // The index of element 0 in a larger map when a slice of the elements is
+  // tested apart (combine_elementwise): bad_element and messages use it.
+  std::size_t first_element = 0;
 };
 
 template <class G>
@@ -70,6 +74,11 @@ struct ElementwiseResult {
   std::vector<Scalar> q_value;  // Benjamini-Hochberg over the K p-values
   std::vector<Scalar> p_fwer;   // (1 + #{b : max_j T_jb >= T_k}) / (B + 1)
   int failed_permutations = 0;  // (element, relabelling) pairs without a statistic
+  // What combine_elementwise needs to join slices of elements: T_k on the
+  // ranking scale (D_B where the statistic is H^2), and max_k T_kb per
+  // relabelling b (failed statistics count as +inf).
+  std::vector<Scalar> ranked_value;
+  std::vector<Scalar> relabelling_maximum;
 
   bool ok() const { return is_success(status); }
 };
@@ -94,6 +103,26 @@ std::vector<Scalar> benjamini_hochberg(const std::vector<Scalar>& p) {
     q[order[r]] = running;
   }
   return q;
+}
+
+// The family-wise p-values and the q-values, from T_k (ranked), max_k T_kb
+// and the per-element p-values: the one step that needs every element.
+// #{b : max_k T_kb >= threshold} by binary search in the sorted maxima:
+// O((B + K) log B), not K B comparisons (K = 1e5, B = 1e4 would be 1e9).
+template <class G>
+void adjust_for_multiplicity(ElementwiseResult<G>& result) {
+  using Scalar = typename G::Scalar;
+  const std::size_t elements = result.ranked_value.size();
+  std::vector<Scalar> sorted = result.relabelling_maximum;
+  std::sort(sorted.begin(), sorted.end());
+  const Scalar denominator = Scalar(sorted.size() + 1);
+  result.p_fwer.assign(elements, 1);
+  for (std::size_t k = 0; k < elements; ++k) {
+    const Scalar threshold = result.ranked_value[k] * (1 - two_sample_detail::kTie<Scalar>);
+    const auto beyond = sorted.end() - std::lower_bound(sorted.begin(), sorted.end(), threshold);
+    result.p_fwer[k] = Scalar(1 + beyond) / denominator;
+  }
+  result.q_value = benjamini_hochberg(result.p_value);
 }
 
 // The linearised statistic of one split of fixed coordinates z (the first
@@ -167,7 +196,7 @@ ElementwiseResult<G> elementwise_two_sample_test(
   {
     std::vector<std::size_t> order;
     for (std::size_t r = 0; r < count; ++r) {
-      permutation(test.seed, r, total, order);
+      permutation(test.seed, test.first_permutation + r, total, order);
       std::copy(order.begin(), order.end(),
                 orders.begin() + static_cast<std::ptrdiff_t>(r * total));
     }
@@ -269,25 +298,69 @@ ElementwiseResult<G> elementwise_two_sample_test(
   for (std::size_t k = 0; k < elements; ++k) {
     if (element_ok[k]) continue;
     result.status = element_status[k];
-    result.bad_element = static_cast<std::ptrdiff_t>(k);
-    result.message = "element " + std::to_string(k) + ": " + element_message[k];
+    result.bad_element = static_cast<std::ptrdiff_t>(options.first_element + k);
+    result.message =
+        "element " + std::to_string(options.first_element + k) + ": " + element_message[k];
     return result;
   }
-  const Scalar denominator = Scalar(count + 1);
-  result.p_fwer.assign(elements, 1);
   for (std::size_t k = 0; k < elements; ++k) {
     result.value[k] =
         test.statistic == TwoSampleStatistic::hellinger ? -std::expm1(-observed[k]) : observed[k];
-    result.p_value[k] = Scalar(1 + extreme[k]) / denominator;
-    const Scalar threshold = observed[k] * (1 - two_sample_detail::kTie<Scalar>);
-    int beyond = 0;
-    for (std::size_t r = 0; r < count; ++r)
-      beyond += maximum[r] >= threshold ? 1 : 0;
-    result.p_fwer[k] = Scalar(1 + beyond) / denominator;
+    result.p_value[k] = permutation_p_value<Scalar>(extreme[k], test.permutations);
   }
-  result.q_value = elementwise_detail::benjamini_hochberg(result.p_value);
+  result.ranked_value = std::move(observed);
+  result.relabelling_maximum = std::move(maximum);
+  elementwise_detail::adjust_for_multiplicity(result);
   result.permutations = test.permutations;
   result.failed_permutations = failed;
+  result.status = Status::converged;
+  return result;
+}
+
+// One map from maps of consecutive slices of the elements (each run with
+// the same samples' subjects, options and seed on its own elements, e.g. on
+// its own machine), given in element order: the per-element values are
+// concatenated, max_k T_kb is taken over the slices and the family-wise
+// and q-values are computed over all elements, so the result equals the
+// map of all elements at once exactly. Refused (invalid_input) unless
+// every slice ran with the same relabellings.
+template <class G>
+ElementwiseResult<G> combine_elementwise(const std::vector<ElementwiseResult<G>>& slices) {
+  ElementwiseResult<G> result;
+  if (slices.empty()) {
+    result.message = "combine_elementwise: no slices";
+    return result;
+  }
+  const std::size_t count = slices.front().relabelling_maximum.size();
+  result.relabelling_maximum.assign(count, -std::numeric_limits<typename G::Scalar>::infinity());
+  for (std::size_t s = 0; s < slices.size(); ++s) {
+    const ElementwiseResult<G>& slice = slices[s];
+    if (!slice.ok()) {
+      result.message = "slice " + std::to_string(s) + " did not run: " + slice.message;
+      return result;
+    }
+    const std::size_t k = slice.elements;
+    if (slice.permutations != slices.front().permutations ||
+        slice.relabelling_maximum.size() != count || slice.value.size() != k ||
+        slice.ranked_value.size() != k || slice.p_value.size() != k) {
+      result.message = "slice " + std::to_string(s) +
+                       " does not hold one value per element and one maximum per relabelling "
+                       "of the same " +
+                       std::to_string(count) + " relabellings";
+      return result;
+    }
+    result.value.insert(result.value.end(), slice.value.begin(), slice.value.end());
+    result.ranked_value.insert(result.ranked_value.end(), slice.ranked_value.begin(),
+                               slice.ranked_value.end());
+    result.p_value.insert(result.p_value.end(), slice.p_value.begin(), slice.p_value.end());
+    for (std::size_t r = 0; r < count; ++r)
+      result.relabelling_maximum[r] =
+          std::max(result.relabelling_maximum[r], slice.relabelling_maximum[r]);
+    result.failed_permutations += slice.failed_permutations;
+  }
+  result.elements = result.value.size();
+  result.permutations = slices.front().permutations;
+  elementwise_detail::adjust_for_multiplicity(result);
   result.status = Status::converged;
   return result;
 }

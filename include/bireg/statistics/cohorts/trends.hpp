@@ -54,6 +54,9 @@ struct FitManyOptions {
   Scalar t0 = std::numeric_limits<Scalar>::quiet_NaN();
   Scalar t1 = std::numeric_limits<Scalar>::quiet_NaN();
   int threads = 1;  // subjects fitted at once (1 to kMaxThreads); the result does not depend on it
+  // The index of subjects[0] in its cohort, when a block of a cohort is
+  // fitted apart (bireg.dask): messages name subjects by their cohort index.
+  std::size_t first_subject = 0;
 };
 
 template <class G>
@@ -140,7 +143,8 @@ FitManyResult<G> fit_many(const GeodesicRegression<G>& regression,
     if (result.fits[i].ok()) continue;
     if (result.failed++ == 0) {
       result.status = result.fits[i].status;
-      result.message = "subject " + std::to_string(i) + ": " + to_string(result.fits[i].status) +
+      result.message = "subject " + std::to_string(options.first_subject + i) + ": " +
+                       to_string(result.fits[i].status) +
                        (result.fits[i].message.empty() ? "" : ": " + result.fits[i].message);
     }
   }

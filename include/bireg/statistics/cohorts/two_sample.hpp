@@ -22,6 +22,12 @@
 // sample, each with both means recomputed (the exact mode). Relabelling b
 // depends on (seed, b) only (permutation.hpp) and is evaluated by the same
 // arithmetic on any thread, so p does not depend on `threads`.
+//
+// The relabellings can be shared out among processes (bireg.dask, MPI):
+// each share runs b = first_permutation .. first_permutation + B_s - 1 of
+// the same seed, and combine_two_sample adds the shares' counts. The
+// counts are integers, so the combined p equals the one-process p exactly,
+// for any number and order of shares.
 #pragma once
 
 #include <algorithm>
@@ -81,6 +87,10 @@ struct TwoSampleOptions {
   // p_value = 1).
   int permutations = 9999;
   std::uint64_t seed = 0;
+  // The first relabelling's index in the seed's stream: 0 for a whole
+  // test, the share's offset when a test is shared out (combine_two_sample).
+  // first_permutation + permutations is at most kMaxTwoSamplePermutations.
+  std::uint64_t first_permutation = 0;
   // Threads for the relabellings (1 to kMaxThreads); the result does not
   // depend on it. A std::bad_alloc on a worker terminates.
   int threads = 1;
@@ -108,9 +118,10 @@ struct TwoSampleResult {
   TwoSampleVariant variant = TwoSampleVariant::invariant;
   Scalar value = 0;  // T^2, D_B or H^2 of the data
   Scalar p_value = 1;
-  int permutations = 0;
-  int at_least_as_extreme = 0;  // #{b : T_b >= T}, failed relabellings included
-  int failed_permutations = 0;  // relabellings whose statistic could not be computed
+  std::uint64_t first_permutation = 0;  // this result's relabellings: first_permutation ..
+  int permutations = 0;                 // .. first_permutation + permutations - 1
+  int at_least_as_extreme = 0;          // #{b : T_b >= T}, failed relabellings included
+  int failed_permutations = 0;          // relabellings whose statistic could not be computed
 
   std::optional<Element> mean_a, mean_b;
   Tangent mean_difference = Tangent::Zero();          // c = log(m_A^{-1} m_B)
@@ -121,7 +132,21 @@ struct TwoSampleResult {
   bool ok() const { return is_success(status); }
 };
 
+// p = (1 + #{b : T_b >= T}) / (B + 1): the permutation p-value, which is
+// exact (P(p <= alpha) <= alpha under exchangeability) because the
+// observed split is counted among the B + 1.
+template <class Scalar>
+Scalar permutation_p_value(int at_least_as_extreme, int permutations) {
+  return Scalar(1 + at_least_as_extreme) / Scalar(1 + permutations);
+}
+
 namespace two_sample_detail {
+
+inline std::string failed_relabellings_message(int failed) {
+  return std::to_string(failed) +
+         " relabellings had no statistic (a mean failed or a covariance was singular) and count "
+         "as at least as extreme";
+}
 
 // Elements of a pooled sample picked by index: what mean() reads.
 template <class Element>
@@ -321,6 +346,11 @@ std::string refusal(std::size_t m, std::size_t n,
     return "permutations must be 0 to " + std::to_string(kMaxTwoSamplePermutations) + ", not " +
            std::to_string(options.permutations);
   }
+  const auto limit = static_cast<std::uint64_t>(kMaxTwoSamplePermutations);
+  if (options.first_permutation > limit - static_cast<std::uint64_t>(options.permutations)) {
+    return "first_permutation + permutations must be at most " + std::to_string(limit) + ", not " +
+           std::to_string(options.first_permutation) + " + " + std::to_string(options.permutations);
+  }
   if (options.threads < 1 || options.threads > kMaxThreads) {
     return "threads must be 1 to " + std::to_string(kMaxThreads) + ", not " +
            std::to_string(options.threads);
@@ -433,7 +463,7 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
     split.y_b.reserve(n);
     const std::size_t end = std::min(count, (block + 1) * detail::kBlock);
     for (std::size_t b = block * detail::kBlock; b < end; ++b) {
-      permutation(options.seed, b, m + n, order);
+      permutation(options.seed, options.first_permutation + b, m + n, order);
       detail::evaluate<G>(pooled, order.data(), m, n, ranking, split);
       verdicts[b] = !split.value                ? detail::Verdict::failed
                     : *split.value >= threshold ? detail::Verdict::at_least_as_extreme
@@ -450,14 +480,79 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
     result.failed_permutations += verdict == detail::Verdict::failed ? 1 : 0;
     result.at_least_as_extreme += verdict == detail::Verdict::less_extreme ? 0 : 1;
   }
+  result.first_permutation = options.first_permutation;
   result.permutations = options.permutations;
-  result.p_value = Scalar(1 + result.at_least_as_extreme) / Scalar(1 + options.permutations);
+  result.p_value = permutation_p_value<Scalar>(result.at_least_as_extreme, options.permutations);
   result.status = Status::converged;
   if (result.failed_permutations > 0) {
-    result.message = std::to_string(result.failed_permutations) +
-                     " relabellings had no statistic (a mean failed or a covariance was "
-                     "singular) and count as at least as extreme";
+    result.message = detail::failed_relabellings_message(result.failed_permutations);
   }
+  return result;
+}
+
+// One test from its shares (two_sample_test runs with first_permutation
+// and permutations set per share), in any order: the counts are added and
+// p recomputed, the rest is the first share's. Refused (invalid_input, the
+// message says why) unless every share ran, they agree on the statistic,
+// variant and observed value (the same data and build), and their
+// relabellings tile 0 .. B - 1 without gap or overlap.
+template <class G>
+TwoSampleResult<G> combine_two_sample(const std::vector<TwoSampleResult<G>>& shares) {
+  using Scalar = typename G::Scalar;
+  TwoSampleResult<G> refused;
+  if (shares.empty()) {
+    refused.message = "combine_two_sample: no shares";
+    return refused;
+  }
+  std::vector<std::size_t> order(shares.size());
+  for (std::size_t s = 0; s < shares.size(); ++s) {
+    if (!shares[s].ok()) {
+      refused.message = "share " + std::to_string(s) + " did not run: " + shares[s].message;
+      return refused;
+    }
+    order[s] = s;
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+    return shares[x].first_permutation < shares[y].first_permutation;
+  });
+  const TwoSampleResult<G>& first = shares[order.front()];
+  TwoSampleResult<G> result = first;
+  std::uint64_t next = 0;
+  long long at_least = 0, failed = 0, total = 0;
+  for (const std::size_t s : order) {
+    const TwoSampleResult<G>& share = shares[s];
+    if (share.statistic != first.statistic || share.variant != first.variant ||
+        !(share.value == first.value)) {
+      refused.message = "share " + std::to_string(s) +
+                        " disagrees with the others on the statistic or its observed value: "
+                        "the shares were computed from different data, options or builds";
+      return refused;
+    }
+    if (share.first_permutation != next) {
+      refused.message = "the shares' relabellings do not tile 0 .. B - 1: share " +
+                        std::to_string(s) + " starts at " +
+                        std::to_string(share.first_permutation) + ", expected " +
+                        std::to_string(next);
+      return refused;
+    }
+    next += static_cast<std::uint64_t>(share.permutations);
+    at_least += share.at_least_as_extreme;
+    failed += share.failed_permutations;
+    total += share.permutations;
+  }
+  if (total > kMaxTwoSamplePermutations) {
+    refused.message = "the shares hold " + std::to_string(total) + " relabellings, more than " +
+                      std::to_string(kMaxTwoSamplePermutations);
+    return refused;
+  }
+  result.first_permutation = 0;
+  result.permutations = static_cast<int>(total);
+  result.at_least_as_extreme = static_cast<int>(at_least);
+  result.failed_permutations = static_cast<int>(failed);
+  result.p_value = permutation_p_value<Scalar>(result.at_least_as_extreme, result.permutations);
+  result.message = result.failed_permutations > 0
+                       ? two_sample_detail::failed_relabellings_message(result.failed_permutations)
+                       : std::string();
   return result;
 }
 

@@ -1,0 +1,186 @@
+"""bireg on a Dask cluster: the cohorts' work spread over the workers of a
+``distributed`` client, with the answers of one process.
+
+Install with ``pip install ".[dask]"``. Each function takes the arguments
+of the local function of the same name, plus ``client`` (default: the
+current ``distributed`` client) and ``blocks`` (how many tasks; default
+four per worker), accepts numpy or Dask arrays, and returns the local
+function's result type:
+
+* ``fit_many``: the subjects in blocks; each block is the local fit_many on
+  the same shared interval, so every trend equals the local one bit for bit.
+* ``two_sample_test`` of two samples of elements, and ``compare_trends``:
+  the relabellings in blocks. Relabelling b depends on (seed, b) only, each
+  block counts its own, and ``bireg::combine_two_sample`` adds the integer
+  counts: p equals the local p exactly for any number of workers, blocks
+  and threads.
+* ``two_sample_test`` of element-wise maps ((m, K, n, n) arrays): the
+  elements in blocks, each with all the relabellings;
+  ``bireg::combine_elementwise`` joins them, since the q-values and the
+  family-wise p-values need every element.
+
+A task is a pure function of its arguments, so a task whose worker died is
+run again by Dask with the same result. Workers print nothing: progress is
+Dask's own (the dashboard, or ``distributed.progress`` on futures). On a
+real cluster only the client changes (``distributed.Client(address)``,
+dask-jobqueue's ``SLURMCluster``, dask-kubernetes); docs/distributed.md
+says how the cost scales.
+"""
+
+import numpy as np
+
+try:
+    import distributed
+except ImportError as error:  # pragma: no cover - depends on the installation
+    raise ImportError("bireg.dask needs Dask's distributed scheduler: "
+                      "pip install \"bireg[dask]\" (or dask and distributed)") from error
+
+from . import __version__, _arrays
+from . import cohorts as _cohorts
+from . import groups as _groups
+from ._bireg import combine_elementwise, combine_two_sample
+
+__all__ = ["fit_many", "two_sample_test", "compare_trends"]
+
+_BLOCKS_PER_WORKER = 4
+
+
+def _client(client):
+    if client is not None:
+        return client
+    try:
+        return distributed.get_client()
+    except ValueError:
+        raise ValueError("bireg.dask needs a distributed client: create one "
+                         "(distributed.Client(...)) or pass client=") from None
+
+
+def _worker_version():
+    """Run on each worker: bireg's version there, or why it cannot be imported."""
+    try:
+        import bireg
+    except ImportError as error:
+        return f"bireg cannot be imported ({error})"
+    return bireg.__version__
+
+
+def _check_workers(client):
+    """RuntimeError naming the workers that lack bireg or have another version."""
+    versions = client.run(_worker_version)
+    if not versions:
+        raise RuntimeError("the Dask client has no workers")
+    wrong = {worker: found for worker, found in versions.items() if found != __version__}
+    if wrong:
+        listed = "; ".join(f"{worker}: {found}" for worker, found in sorted(wrong.items()))
+        raise RuntimeError(f"every worker needs bireg {__version__}, as the client has; "
+                           f"{listed}")
+    return len(versions)
+
+
+def _blocks(count, blocks, workers):
+    """(first, size) of `blocks` consecutive blocks of range(count), sizes
+    differing by at most one; at least one block, none empty unless count
+    is 0."""
+    if blocks is None:
+        blocks = _BLOCKS_PER_WORKER * workers
+    blocks = _arrays.positive_int(blocks, "blocks")
+    if blocks < 1:
+        raise ValueError(f"blocks must be at least 1, got {blocks}")
+    blocks = min(blocks, max(count, 1))
+    edges = [count * i // blocks for i in range(blocks + 1)]
+    return [(edges[i], edges[i + 1] - edges[i]) for i in range(blocks)]
+
+
+def _gather(client, function, plan, blocks):
+    """function(plan, first, size) for every block, on the workers, in
+    block order. The plan is sent once to the workers."""
+    shared = client.scatter(plan, broadcast=True, hash=False)
+    futures = [client.submit(function, shared, first, size, pure=False) for first, size in blocks]
+    return client.gather(futures)
+
+
+def _test_share(plan, first, size):
+    return plan.run_test(first, size)
+
+
+def _map_slice(plan, first, size):
+    return plan.run_map(first, size)
+
+
+def _trend_share(plan, first, size):
+    return plan.run(first, size)
+
+
+def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", permutations=9999,
+                    seed=0, threads=1, mode="exact", client=None, blocks=None):
+    """``bireg.two_sample_test`` on the workers: the relabellings (a test of
+    elements) or the elements (a map) in ``blocks`` tasks. The result equals
+    the local one with the same arguments, whatever the number of workers,
+    blocks or threads."""
+    client = _client(client)
+    plan = _cohorts._plan(np.asarray(A), np.asarray(B), group, statistic, variant, permutations,
+                          seed, threads, mode)
+    workers = _check_workers(client)
+    if plan.elements == 0:
+        shares = _gather(client, _test_share, plan, _blocks(plan.permutations, blocks, workers))
+        return _cohorts._test_result(combine_two_sample(plan.group, shares))
+    slices = _gather(client, _map_slice, plan, _blocks(plan.elements, blocks, workers))
+    return _cohorts._map_result(combine_elementwise(plan.group, slices))
+
+
+def compare_trends(trends_a, trends_b, group, statistic="hotelling", variant="invariant",
+                   permutations=9999, seed=0, threads=1, client=None, blocks=None):
+    """``bireg.compare_trends`` on the workers, the relabellings in
+    ``blocks`` tasks; equal to the local result."""
+    client = _client(client)
+    plan = _cohorts._trend_plan(np.asarray(trends_a), np.asarray(trends_b), group, statistic,
+                                variant, permutations, seed, threads)
+    workers = _check_workers(client)
+    shares = _gather(client, _trend_share, plan, _blocks(plan.permutations, blocks, workers))
+    return _cohorts._test_result(combine_two_sample(plan.group, shares))
+
+
+def _fit_subjects(subjects, first, group, t0, t1, threads):
+    return _cohorts._fit_block(subjects, group, t0, t1, threads, first)
+
+
+def fit_many(subjects, group, interval=None, threads=1, client=None, blocks=None):
+    """``bireg.fit_many`` on the workers, the subjects (a sequence of (t, Y)
+    pairs) in ``blocks`` tasks of consecutive subjects. Without
+    ``interval`` the shared interval is, as locally, from the smallest to
+    the largest finite covariate of all subjects; it is found on the client
+    so that every block uses the same one. A failed fit raises ValueError
+    naming the subject by its index in ``subjects``."""
+    client = _client(client)
+    g = _groups.get(group)
+    threads = _arrays.positive_int(threads, "threads")
+    pairs = []
+    for i, subject in enumerate(subjects):
+        t, Y = _pair(subject, i)
+        pairs.append((_arrays.covariates(t, f"subject {i}'s t"), np.asarray(Y)))
+    if not pairs:
+        raise ValueError("fit_many: there are no subjects")
+    t0, t1 = _cohorts._interval(interval)
+    if interval is None:
+        finite = [t[np.isfinite(t)] for t, _ in pairs]
+        finite = [t for t in finite if t.size]
+        if finite:
+            t0 = float(min(t.min() for t in finite))
+            t1 = float(max(t.max() for t in finite))
+    workers = _check_workers(client)
+    futures = [client.submit(_fit_subjects, pairs[first:first + size], first, g.name, t0, t1,
+                             threads, pure=False)
+               for first, size in _blocks(len(pairs), blocks, workers)]
+    parts = client.gather(futures)
+    return _cohorts.FitManyResult(
+        t0=parts[0]["t0"], t1=parts[0]["t1"],
+        trends=np.concatenate([part["trends"] for part in parts]),
+        n_iter=np.concatenate([part["n_iter"] for part in parts]))
+
+
+def _pair(subject, index):
+    try:
+        t, Y = subject
+    except (TypeError, ValueError):
+        raise ValueError(f"subject {index} must be a pair (t, Y)") from None
+    return t, Y

@@ -1,0 +1,178 @@
+"""bireg.dask on a local cluster of worker processes: every result equals the
+local function's exactly, whatever the number of workers and blocks; a
+worker that dies mid-computation changes nothing; bad data are refused with
+the index the local function gives."""
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import bireg
+
+distributed = pytest.importorskip("distributed")
+import bireg.dask  # noqa: E402  (after the skip: it needs distributed)
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=3, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=40)
+    with distributed.Client(cluster) as c:
+        yield c
+    cluster.close()
+
+
+@pytest.fixture()
+def rng():
+    return np.random.default_rng(20261126)
+
+
+def rotations(rng, count, centre, sd=0.3):
+    g = bireg.SO3
+    return g.compose(centre, g.exp(sd * rng.standard_normal((count, 3))))
+
+
+def subjects(rng, count, velocity):
+    g = bireg.SE3
+    out = []
+    for _ in range(count):
+        start = g.exp(0.1 * rng.standard_normal(6))
+        t = np.sort(rng.uniform(0, 2, 9))
+        Y = g.compose(start, g.exp(t[:, None] * (velocity + 0.05 * rng.standard_normal(6))))
+        out.append((t, g.compose(Y, g.exp(0.02 * rng.standard_normal((9, 6))))))
+    return out
+
+
+def same(x, y):
+    """Equal field by field, exactly (arrays bit for bit)."""
+    assert type(x) is type(y)
+    for name, value in vars(x).items():
+        other = vars(y)[name]
+        if isinstance(value, np.ndarray):
+            assert value.shape == other.shape and np.array_equal(value, other), name
+        else:
+            assert value == other, name
+
+
+def workers(client, count):
+    """A client restricted to the first `count` workers: the same cluster,
+    seen as a smaller one."""
+    addresses = sorted(client.scheduler_info()["workers"])[:count]
+
+    class Restricted:
+        def __getattr__(self, name):
+            return getattr(client, name)
+
+        def submit(self, *args, **kwargs):
+            return client.submit(*args, workers=addresses, allow_other_workers=False, **kwargs)
+
+        def scatter(self, data, **kwargs):
+            kwargs.pop("broadcast", None)
+            return client.scatter(data, workers=addresses, broadcast=True, **kwargs)
+
+        def run(self, function, **kwargs):
+            return client.run(function, workers=addresses, **kwargs)
+
+    return Restricted()
+
+
+@pytest.mark.parametrize("statistic", ["hotelling", "bhattacharyya", "hellinger"])
+def test_two_sample_p_is_the_local_p_for_any_workers_and_blocks(client, rng, statistic):
+    a = rotations(rng, 14, np.eye(3))
+    b = rotations(rng, 15, bireg.SO3.exp(np.array([0.25, 0.0, 0.0])))
+    local = bireg.two_sample_test(a, b, group="SO3", statistic=statistic, permutations=499,
+                                  seed=3)
+    # A p strictly inside (1/(B+1), 1): a count a wrong block would move.
+    assert 1 < local.at_least_as_extreme < 499
+    for count in (1, 2, 3):
+        for blocks in (1, 3, 10):
+            spread = bireg.dask.two_sample_test(a, b, group="SO3", statistic=statistic,
+                                                permutations=499, seed=3,
+                                                client=workers(client, count), blocks=blocks)
+            same(spread, local)
+
+
+def test_elementwise_map_is_the_local_map_in_slices(client, rng):
+    m, k, K = 8, 9, 23
+    centre = bireg.SO3.exp(np.array([0.1, -0.2, 0.3]))
+    A = rotations(rng, m * K, centre, 0.2).reshape(m, K, 3, 3)
+    B = rotations(rng, k * K, centre, 0.2).reshape(k, K, 3, 3)
+    B[:, :5] = bireg.SO3.compose(bireg.SO3.exp(np.array([0.3, 0.0, 0.0])), B[:, :5])
+    for mode in ("linearised", "exact"):
+        local = bireg.two_sample_test(A, B, group="SO3", permutations=199, seed=7, mode=mode)
+        assert np.any(local.p_fwer > local.p_value)  # the adjustment needs every element
+        for blocks in (1, 4, 23, 50):
+            spread = bireg.dask.two_sample_test(A, B, group="SO3", permutations=199, seed=7,
+                                                mode=mode, client=client, blocks=blocks)
+            same(spread, local)
+
+
+def test_fit_many_and_compare_trends_are_the_local_ones(client, rng):
+    velocity = np.array([0.3, 0.1, -0.2, 0.5, 0.0, 0.1])
+    cohort_a = subjects(rng, 13, velocity)
+    cohort_b = subjects(rng, 14, velocity + np.array([0.0, 0.15, 0, 0, 0, 0]))
+    for blocks in (1, 4, 13):
+        for interval in (None, (0.0, 2.0)):
+            local = bireg.fit_many(cohort_a, group="SE3", interval=interval)
+            same(bireg.dask.fit_many(cohort_a, group="SE3", interval=interval, client=client,
+                                     blocks=blocks), local)
+    a = bireg.fit_many(cohort_a, group="SE3", interval=(0.0, 2.0)).trends
+    b = bireg.fit_many(cohort_b, group="SE3", interval=(0.0, 2.0)).trends
+    local = bireg.compare_trends(a, b, group="SE3", permutations=299, seed=11)
+    for blocks in (1, 7):
+        same(bireg.dask.compare_trends(a, b, group="SE3", permutations=299, seed=11,
+                                       client=client, blocks=blocks), local)
+
+
+def test_bad_data_are_refused_with_the_local_index(client, rng):
+    cohort = subjects(rng, 9, np.full(6, 0.2))
+    t, Y = cohort[6]
+    Y = Y.copy()
+    Y[4, 0, 3] = np.nan
+    cohort[6] = (t, Y)
+    with pytest.raises(ValueError, match="subject 6: .*observation 4"):
+        bireg.fit_many(cohort, group="SE3")
+    with pytest.raises(ValueError, match="subject 6: .*observation 4"):
+        bireg.dask.fit_many(cohort, group="SE3", client=client, blocks=4)
+    m, k, K = 6, 6, 9
+    A = rotations(rng, m * K, np.eye(3)).reshape(m, K, 3, 3)
+    B = rotations(rng, k * K, np.eye(3)).reshape(k, K, 3, 3)
+    B[2, 7, 1, 1] = np.inf
+    with pytest.raises(ValueError, match="element 7"):
+        bireg.two_sample_test(A, B, group="SO3", permutations=9)
+    with pytest.raises(ValueError, match="element 7"):
+        bireg.dask.two_sample_test(A, B, group="SO3", permutations=9, client=client, blocks=3)
+    with pytest.raises(ValueError, match="blocks"):
+        bireg.dask.two_sample_test(A, B, group="SO3", permutations=9, client=client, blocks=0)
+
+
+def test_a_worker_killed_mid_test_changes_nothing(client, rng):
+    """Runs last: the cluster then has a new worker in place of the killed one."""
+    a = rotations(rng, 40, np.eye(3))
+    b = rotations(rng, 40, bireg.SO3.exp(np.array([0.05, 0.0, 0.0])))
+    local = bireg.two_sample_test(a, b, group="SO3", permutations=30000, seed=5)
+    victim = sorted(client.scheduler_info()["workers"])[0]
+    pid = client.run(os.getpid, workers=[victim])[victim]
+    outcome = {}
+
+    def spread():
+        outcome["result"] = bireg.dask.two_sample_test(a, b, group="SO3", permutations=30000,
+                                                       seed=5, client=client, blocks=12)
+
+    thread = threading.Thread(target=spread)
+    thread.start()
+    # Kill the victim's process (SIGKILL: no clean shutdown) once it is
+    # running a block; its nanny starts a new worker and Dask reruns the
+    # lost blocks elsewhere.
+    deadline = time.monotonic() + 60
+    while not client.processing(workers=[victim]).get(victim) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert client.processing(workers=[victim]).get(victim), "the victim never ran a block"
+    os.kill(pid, signal.SIGKILL)
+    thread.join(timeout=180)
+    assert not thread.is_alive()
+    same(outcome["result"], local)
