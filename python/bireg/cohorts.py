@@ -10,7 +10,7 @@ cohorts' trends in G x G, ``population_trend`` pools them. p-values come
 from seeded relabellings and do not depend on ``threads``.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -78,6 +78,7 @@ class _TestPlan:
     seed: int
     threads: int
     mode: str
+    first_element: int = 0  # a slice of a larger map: its elements' first index there
 
     def run_test(self, first_permutation=0, permutations=None):
         """The dict of bireg::two_sample_test on relabellings
@@ -86,19 +87,25 @@ class _TestPlan:
         return _bireg.two_sample_test(self.group, self.a, self.b, self.statistic, self.variant,
                                       count, self.seed, self.threads, first_permutation)
 
-    def run_map(self, first_element=0, elements=None):
-        """The dict of bireg::elementwise_two_sample_test on elements
-        first_element .. + elements - 1 (all by default)."""
-        K = self.elements
-        count = K - first_element if elements is None else elements
+    def slice(self, first, count):
+        """The plan of elements first .. first + count - 1 of this map alone:
+        what one worker holds (bireg.dask)."""
         n = self.a.shape[-1]
-        a = self.a.reshape(-1, K, n, n)[:, first_element:first_element + count]
-        b = self.b.reshape(-1, K, n, n)[:, first_element:first_element + count]
-        m, k = a.shape[0], b.shape[0]
+
+        def part(x):
+            x = x.reshape(-1, self.elements, n, n)[:, first:first + count]
+            return np.ascontiguousarray(x).reshape(-1, n, n)
+
+        return replace(self, a=part(self.a), b=part(self.b), elements=count,
+                       first_element=self.first_element + first)
+
+    def run_map(self):
+        """The dict of bireg::elementwise_two_sample_test on this plan's elements."""
+        K = self.elements
         return _bireg.elementwise_two_sample_test(
-            self.group, np.ascontiguousarray(a).reshape(m * count, n, n), m,
-            np.ascontiguousarray(b).reshape(k * count, n, n), k, count, self.statistic,
-            self.variant, self.permutations, self.seed, self.threads, self.mode, first_element)
+            self.group, self.a, self.a.shape[0] // K, self.b, self.b.shape[0] // K, K,
+            self.statistic, self.variant, self.permutations, self.seed, self.threads, self.mode,
+            self.first_element)
 
 
 def _plan(A, B, group, statistic, variant, permutations, seed, threads, mode):

@@ -15,7 +15,8 @@ function's result type:
   counts: p equals the local p exactly for any number of workers, blocks
   and threads.
 * ``two_sample_test`` of element-wise maps ((m, K, n, n) arrays): the
-  elements in blocks, each with all the relabellings;
+  elements in blocks, each worker sent only its block's elements (for all
+  subjects), each block with all the relabellings;
   ``bireg::combine_elementwise`` joins them, since the q-values and the
   family-wise p-values need every element.
 
@@ -103,8 +104,8 @@ def _test_share(plan, first, size):
     return plan.run_test(first, size)
 
 
-def _map_slice(plan, first, size):
-    return plan.run_map(first, size)
+def _map_slice(plan):
+    return plan.run_map()
 
 
 def _trend_share(plan, first, size):
@@ -124,8 +125,11 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
     if plan.elements == 0:
         shares = _gather(client, _test_share, plan, _blocks(plan.permutations, blocks, workers))
         return _cohorts._test_result(combine_two_sample(plan.group, shares))
-    slices = _gather(client, _map_slice, plan, _blocks(plan.elements, blocks, workers))
-    return _cohorts._map_result(combine_elementwise(plan.group, slices))
+    # Each worker is sent its own slice of the elements, for all subjects.
+    futures = [client.submit(_map_slice, client.scatter(plan.slice(first, size), hash=False),
+                             pure=False)
+               for first, size in _blocks(plan.elements, blocks, workers)]
+    return _cohorts._map_result(combine_elementwise(plan.group, client.gather(futures)))
 
 
 def compare_trends(trends_a, trends_b, group, statistic="hotelling", variant="invariant",
