@@ -148,38 +148,96 @@ def _fit_subjects(subjects, first, group, t0, t1, threads):
     return _cohorts._fit_block(subjects, group, t0, t1, threads, first)
 
 
+def _covariate_range(subjects, first=0):
+    """(smallest, largest) finite covariate of the subjects, or None: the
+    local fit_many's default interval, found over blocks."""
+    low, high = np.inf, -np.inf
+    for i, subject in enumerate(subjects, start=first):
+        t = _arrays.covariates(_pair(subject, i)[0], f"subject {i}'s t")
+        t = t[np.isfinite(t)]
+        if t.size:
+            low, high = min(low, float(t.min())), max(high, float(t.max()))
+    return (low, high) if low <= high else None
+
+
+def _shared_interval(interval, ranges):
+    """The interval every block uses: the given one, or the covariates'
+    range over all blocks (NaN, NaN when no covariate is finite: the
+    library then refuses, as locally)."""
+    if interval is not None:
+        return _cohorts._interval(interval)
+    ranges = [r for r in ranges if r is not None]
+    if not ranges:
+        return float("nan"), float("nan")
+    return min(r[0] for r in ranges), max(r[1] for r in ranges)
+
+
+def _join_fits(parts):
+    return _cohorts.FitManyResult(
+        t0=parts[0]["t0"], t1=parts[0]["t1"],
+        trends=np.concatenate([part["trends"] for part in parts]),
+        n_iter=np.concatenate([part["n_iter"] for part in parts]))
+
+
 def fit_many(subjects, group, interval=None, threads=1, client=None, blocks=None):
-    """``bireg.fit_many`` on the workers, the subjects (a sequence of (t, Y)
-    pairs) in ``blocks`` tasks of consecutive subjects. Without
+    """``bireg.fit_many`` on the workers. ``subjects`` is a sequence of
+    (t, Y) pairs, split into ``blocks`` tasks of consecutive subjects, or a
+    ``dask.bag.Bag`` of them, one task per non-empty partition (``blocks``
+    does not apply; the bag is read three times: sizes, covariate range and
+    fits, so persist it first if it is costly to read). Without
     ``interval`` the shared interval is, as locally, from the smallest to
-    the largest finite covariate of all subjects; it is found on the client
-    so that every block uses the same one. A failed fit raises ValueError
-    naming the subject by its index in ``subjects``."""
+    the largest finite covariate of all subjects, found before any fit so
+    that every block uses the same one. A failed fit raises ValueError
+    naming the subject by its index in the whole cohort."""
     client = _client(client)
     g = _groups.get(group)
     threads = _arrays.positive_int(threads, "threads")
+    if _is_bag(subjects):
+        return _fit_many_bag(subjects, g.name, interval, threads, client)
     pairs = []
     for i, subject in enumerate(subjects):
         t, Y = _pair(subject, i)
         pairs.append((_arrays.covariates(t, f"subject {i}'s t"), np.asarray(Y)))
     if not pairs:
         raise ValueError("fit_many: there are no subjects")
-    t0, t1 = _cohorts._interval(interval)
-    if interval is None:
-        finite = [t[np.isfinite(t)] for t, _ in pairs]
-        finite = [t for t in finite if t.size]
-        if finite:
-            t0 = float(min(t.min() for t in finite))
-            t1 = float(max(t.max() for t in finite))
+    t0, t1 = _shared_interval(interval, [_covariate_range(pairs)])
     workers = _check_workers(client)
     futures = [client.submit(_fit_subjects, pairs[first:first + size], first, g.name, t0, t1,
                              threads, pure=False)
                for first, size in _blocks(len(pairs), blocks, workers)]
-    parts = client.gather(futures)
-    return _cohorts.FitManyResult(
-        t0=parts[0]["t0"], t1=parts[0]["t1"],
-        trends=np.concatenate([part["trends"] for part in parts]),
-        n_iter=np.concatenate([part["n_iter"] for part in parts]))
+    return _join_fits(client.gather(futures))
+
+
+def _count(partition):
+    return sum(1 for _ in partition)
+
+
+def _is_bag(subjects):
+    try:
+        import dask.bag
+    except ImportError:  # pragma: no cover - distributed depends on dask
+        return False
+    return isinstance(subjects, dask.bag.Bag)
+
+
+def _fit_many_bag(bag, group, interval, threads, client):
+    import dask
+
+    _check_workers(client)
+    partitions = bag.to_delayed()
+    sizes = client.gather(client.compute([dask.delayed(_count)(p) for p in partitions]))
+    firsts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(int).tolist()
+    used = [(p, first) for p, first, size in zip(partitions, firsts, sizes) if size > 0]
+    if not used:
+        raise ValueError("fit_many: there are no subjects")
+    ranges = []
+    if interval is None:
+        ranges = client.gather(client.compute(
+            [dask.delayed(_covariate_range)(p, first) for p, first in used]))
+    t0, t1 = _shared_interval(interval, ranges)
+    fits = client.compute([dask.delayed(_fit_subjects)(p, first, group, t0, t1, threads)
+                           for p, first in used])
+    return _join_fits(client.gather(fits))
 
 
 def _pair(subject, index):

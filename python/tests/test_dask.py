@@ -128,6 +128,40 @@ def test_fit_many_and_compare_trends_are_the_local_ones(client, rng):
                                        client=client, blocks=blocks), local)
 
 
+def test_fit_many_takes_a_bag_of_subjects(client, rng):
+    import dask.bag
+
+    cohort = subjects(rng, 11, np.array([0.2, 0.0, 0.1, 0.3, -0.1, 0.0]))
+    local = bireg.fit_many(cohort, group="SE3")
+    for partitions in (1, 4, 11):
+        bag = dask.bag.from_sequence(cohort, npartitions=partitions)
+        same(bireg.dask.fit_many(bag, group="SE3", client=client), local)
+    # A failed fit in a later partition is named by its cohort index.
+    t, Y = cohort[9]
+    cohort[9] = (t[:1], Y[:1])
+    with pytest.raises(ValueError, match="subject 9:"):
+        bireg.dask.fit_many(dask.bag.from_sequence(cohort, npartitions=4), group="SE3",
+                            client=client)
+
+
+def test_workers_without_the_clients_bireg_are_named():
+    class Cluster:
+        def __init__(self, versions):
+            self.versions = versions
+
+        def run(self, function):
+            return self.versions
+
+    with pytest.raises(RuntimeError, match="tcp://b:1: 0.0.1"):
+        bireg.dask.two_sample_test(np.stack([np.eye(3)] * 4), np.stack([np.eye(3)] * 4),
+                                   group="SO3", permutations=9,
+                                   client=Cluster({"tcp://a:1": bireg.__version__,
+                                                   "tcp://b:1": "0.0.1"}))
+    with pytest.raises(RuntimeError, match="cannot be imported"):
+        bireg.dask.fit_many([(np.arange(3.0), np.stack([np.eye(3)] * 3))], group="SO3",
+                            client=Cluster({"tcp://a:1": "bireg cannot be imported (x)"}))
+
+
 def test_bad_data_are_refused_with_the_local_index(client, rng):
     cohort = subjects(rng, 9, np.full(6, 0.2))
     t, Y = cohort[6]
