@@ -3,8 +3,10 @@
 A Python face for the header-only C++ library of the same name: the
 groups with vectorised operations, ``GeodesicRegression`` and
 ``LocalRegression`` in scikit-learn's style, the bi-invariant ``mean``,
-the two-sample tests of cohorts, and the trajectory readers. The README
-maps each name to its C++ counterpart.
+the two-sample tests of cohorts and their trends, and the trajectory
+readers; ``bireg.dask`` (imported on its own, with the ``dask`` extra)
+runs the cohorts on a Dask cluster. The README maps each name to its C++
+counterpart.
 """
 
 from ._bireg import __version__
