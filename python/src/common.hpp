@@ -130,7 +130,9 @@ class ResultMemory {
     return static_cast<double*>(memory);
   }
 
-  static void release(void* memory) noexcept { std::free(memory); }
+  static void release(void* memory) noexcept {
+    std::free(memory);
+  }
 
  private:
   static void* checked(void* memory) {
