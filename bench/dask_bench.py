@@ -61,9 +61,10 @@ def main():
     for name, seconds in rows:
         print(f"  {name:28s} {seconds:8.3f} s")
     times = dict(rows)
-    print(f"  2 workers over 1:            {times['bireg.dask, 1 worker(s)'] / times['bireg.dask, 2 worker(s)']:.2f}x")
-    print(f"  Dask over local, 1 core:     {times['bireg.dask, 1 worker(s)'] / times['local, 1 thread(s)'] - 1:+.1%}")
-    print(f"  Dask over local, 2 cores:    {times['bireg.dask, 2 worker(s)'] / times['local, 2 thread(s)'] - 1:+.1%}")
+    one_worker, two_workers = times["bireg.dask, 1 worker(s)"], times["bireg.dask, 2 worker(s)"]
+    print(f"  2 workers over 1:            {one_worker / two_workers:.2f}x")
+    print(f"  Dask over local, 1 core:     {one_worker / times['local, 1 thread(s)'] - 1:+.1%}")
+    print(f"  Dask over local, 2 cores:    {two_workers / times['local, 2 thread(s)'] - 1:+.1%}")
     print(f"  p-values: {sorted(p_values)} ({'identical' if len(p_values) == 1 else 'DIFFERENT'})")
     if len(p_values) != 1:
         raise SystemExit(1)
