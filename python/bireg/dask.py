@@ -16,7 +16,9 @@ function's result type:
   and threads.
 * ``two_sample_test`` of element-wise maps ((m, K, n, n) arrays): the
   elements in blocks, each worker sent only its block's elements (for all
-  subjects), each block with all the relabellings;
+  subjects; from Dask arrays, each worker computes its block from their
+  chunks and the client never holds the cohorts), each block with all the
+  relabellings;
   ``bireg::combine_elementwise`` joins them, since the q-values and the
   family-wise p-values need every element.
 
@@ -27,6 +29,8 @@ real cluster only the client changes (``distributed.Client(address)``,
 dask-jobqueue's ``SLURMCluster``, dask-kubernetes); docs/distributed.md
 says how the cost scales.
 """
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -119,8 +123,10 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
     the local one with the same arguments, whatever the number of workers,
     blocks or threads."""
     client = _client(client)
-    plan = _cohorts._plan(np.asarray(A), np.asarray(B), group, statistic, variant, permutations,
-                          seed, threads, mode)
+    arguments = (group, statistic, variant, permutations, seed, threads, mode)
+    if _is_dask_array(A) and _is_dask_array(B) and A.ndim == 4 and B.ndim == 4:
+        return _lazy_map(A, B, arguments, client, blocks)
+    plan = _cohorts._plan(np.asarray(A), np.asarray(B), *arguments)
     workers = _check_workers(client)
     if plan.elements == 0:
         shares = _gather(client, _test_share, plan, _blocks(plan.permutations, blocks, workers))
@@ -130,6 +136,42 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
                              pure=False)
                for first, size in _blocks(plan.elements, blocks, workers)]
     return _cohorts._map_result(combine_elementwise(plan.group, client.gather(futures)))
+
+
+def _is_dask_array(x):
+    try:
+        import dask.array
+    except ImportError:  # pragma: no cover - distributed depends on dask
+        return False
+    return isinstance(x, dask.array.Array)
+
+
+def _slice_map(a, b, arguments, first):
+    """Run on a worker: the map of elements first .. of this slice, whose
+    arrays the worker computed from its chunks."""
+    plan = _cohorts._plan(a, b, *arguments)
+    return replace(plan, first_element=first).run_map()
+
+
+def _lazy_map(A, B, arguments, client, blocks):
+    """An element-wise map of two Dask arrays (m, K, n, n) and (k, K, n, n):
+    each task computes its own slice of the elements from the arrays'
+    chunks on a worker, so no machine, the client included, holds the whole
+    cohorts. Shapes are checked here; everything else by the library on
+    the workers, which name the element by its index in the whole map."""
+    import dask
+
+    g = _groups.get(arguments[0])
+    n = g.matrix_size
+    if A.shape[2:] != (n, n) or B.shape[2:] != (n, n) or A.shape[1] != B.shape[1]:
+        raise ValueError(f"A and B must have shape (m, K, {n}, {n}) and (k, K, {n}, {n}) with "
+                         f"one K, got {A.shape} and {B.shape}")
+    workers = _check_workers(client)
+    tasks = [dask.delayed(_slice_map, pure=False)(A[:, first:first + size],
+                                                  B[:, first:first + size], arguments, first)
+             for first, size in _blocks(int(A.shape[1]), blocks, workers)]
+    slices = client.gather(client.compute(tasks))
+    return _cohorts._map_result(combine_elementwise(g.name, slices))
 
 
 def compare_trends(trends_a, trends_b, group, statistic="hotelling", variant="invariant",

@@ -111,6 +111,29 @@ def test_elementwise_map_is_the_local_map_in_slices(client, rng):
             same(spread, local)
 
 
+def test_a_map_of_dask_arrays_is_computed_slice_by_slice_on_the_workers(client, rng):
+    import dask.array
+
+    m, k, K = 7, 8, 19
+    A = rotations(rng, m * K, np.eye(3), 0.2).reshape(m, K, 3, 3)
+    B = rotations(rng, k * K, np.eye(3), 0.2).reshape(k, K, 3, 3)
+    B[:, 3:6] = bireg.SO3.compose(bireg.SO3.exp(np.array([0.0, 0.35, 0.0])), B[:, 3:6])
+    local = bireg.two_sample_test(A, B, group="SO3", permutations=199, seed=2,
+                                  mode="linearised")
+    lazy_a = dask.array.from_array(A, chunks=(m, 4, 3, 3))
+    lazy_b = dask.array.from_array(B, chunks=(k, 4, 3, 3))
+    for blocks in (1, 5, 19):
+        same(bireg.dask.two_sample_test(lazy_a, lazy_b, group="SO3", permutations=199, seed=2,
+                                        mode="linearised", client=client, blocks=blocks), local)
+    # A bad element is named by its index in the whole map, from a worker.
+    B[4, 11, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="element 11"):
+        bireg.dask.two_sample_test(lazy_a, dask.array.from_array(B, chunks=(k, 4, 3, 3)),
+                                   group="SO3", permutations=19, client=client, blocks=3)
+    with pytest.raises(ValueError, match="one K"):
+        bireg.dask.two_sample_test(lazy_a, lazy_b[:, :5], group="SO3", client=client)
+
+
 def test_fit_many_and_compare_trends_are_the_local_ones(client, rng):
     velocity = np.array([0.3, 0.1, -0.2, 0.5, 0.0, 0.1])
     cohort_a = subjects(rng, 13, velocity)
