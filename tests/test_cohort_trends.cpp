@@ -196,6 +196,84 @@ TEST_CASE("Comparing trends is invariant under inversion of the data", "[cohorts
   CHECK(std::abs(inverted.value - base.value) <= 1e-6 * base.value);
 }
 
+// The trends at one covariate and the velocities (docs/cohorts.md, "The
+// trends at one covariate", "The velocities"). At t = t0 the test is the
+// element test of the starts, bit for bit. Moving every trend by h on the
+// left or the right leaves both statistics unchanged and p identical (same
+// seed, same relabellings; the tie margin absorbs rounding); inverting every
+// trend leaves the test at t unchanged and changes the velocities' (each
+// v_k moves by its own -Ad(g0_k)).
+TEST_CASE("Trends at one covariate are fully invariant and velocities under translations",
+          "[cohorts][trends]") {
+  using Trend = bireg::Trend<SO3>;
+  std::mt19937 rng(31);
+  Population a{SO3::exp(SO3::Tangent(0.3, 0.1, 0)), SO3::exp(SO3::Tangent(0.9, 0.2, -0.4))};
+  a.spread = 0.3;  // starts far apart: inversion's Ad(g0_k) differ
+  Population b = a;
+  b.g1 = SO3::compose(a.g1, SO3::exp(SO3::Tangent(0.1, -0.1, 0.05)));
+  const std::vector<Trend> trends_a = trends_of(simulate(a, 14, rng));
+  const std::vector<Trend> trends_b = trends_of(simulate(b, 16, rng));
+  bireg::TwoSampleOptions<double> options;
+  options.permutations = 499;
+  options.seed = 8;
+  const double t0 = 0.0, t1 = 1.0, t = 0.4;
+
+  std::vector<SO3::Element> starts_a, starts_b;
+  for (const Trend& trend : trends_a)
+    starts_a.push_back(trend.first);
+  for (const Trend& trend : trends_b)
+    starts_b.push_back(trend.first);
+  const auto starts = bireg::two_sample_test<SO3>(starts_a, starts_b, options);
+  const auto at_start = bireg::compare_trends_at<SO3>(trends_a, trends_b, t0, t1, t0, options);
+  REQUIRE(at_start.ok());
+  CHECK(at_start.value == starts.value);
+  CHECK(at_start.p_value == starts.p_value);
+
+  const auto at = bireg::compare_trends_at<SO3>(trends_a, trends_b, t0, t1, t, options);
+  const auto velocities = bireg::compare_velocities<SO3>(trends_a, trends_b, t0, t1, options);
+  REQUIRE(at.ok());
+  REQUIRE(velocities.ok());
+  // A p strictly inside (1/(B+1), 1), so that a change of the statistic
+  // would show in p.
+  CHECK(velocities.at_least_as_extreme > 0);
+  CHECK(velocities.at_least_as_extreme < 499);
+  const auto moved = [](const std::vector<Trend>& trends, auto move) {
+    std::vector<Trend> out;
+    for (const Trend& trend : trends)
+      out.push_back({move(trend.first), move(trend.second)});
+    return out;
+  };
+  const SO3::Element h = SO3::exp(SO3::Tangent(-0.7, 1.1, 0.4));
+  const auto left = [&](const SO3::Element& g) { return SO3::compose(h, g); };
+  const auto right = [&](const SO3::Element& g) { return SO3::compose(g, h); };
+  const auto inverse = [](const SO3::Element& g) { return SO3::inverse(g); };
+  for (const int which : {0, 1, 2}) {
+    CAPTURE(which);
+    const auto move = [&](const std::vector<Trend>& trends) {
+      return which == 0   ? moved(trends, left)
+             : which == 1 ? moved(trends, right)
+                          : moved(trends, inverse);
+    };
+    const auto at_moved =
+        bireg::compare_trends_at<SO3>(move(trends_a), move(trends_b), t0, t1, t, options);
+    const auto velocities_moved =
+        bireg::compare_velocities<SO3>(move(trends_a), move(trends_b), t0, t1, options);
+    CHECK(std::abs(at_moved.value - at.value) <= 1e-9 * at.value);
+    CHECK(at_moved.p_value == at.p_value);
+    if (which < 2) {
+      CHECK(std::abs(velocities_moved.value - velocities.value) <= 1e-9 * velocities.value);
+      CHECK(velocities_moved.p_value == velocities.p_value);
+    } else {
+      CHECK(std::abs(velocities_moved.value - velocities.value) > 1e-3 * velocities.value);
+    }
+  }
+  // Refusals: a bad interval, a covariate that is not finite.
+  CHECK(bireg::compare_velocities<SO3>(trends_a, trends_b, 1.0, 1.0, options)
+            .message.find("t0 < t1") != std::string::npos);
+  CHECK_FALSE(
+      bireg::compare_trends_at<SO3>(trends_a, trends_b, t0, t1, std::nan(""), options).ok());
+}
+
 // The confidence region of the population trend at level 0.95 holds the
 // generating (g0, g1) in 93-97 % of 1,000 simulated studies of 20 subjects
 // (Binomial(1000, 0.95): standard deviation 0.7 %, the band is +- 2.9 of

@@ -1,8 +1,13 @@
 // bireg: subjects' trends in a longitudinal study (docs/cohorts.md,
 // "Trends"): one geodesic per subject on a shared covariate interval
-// (fit_many), two cohorts' trends compared (compare_trends), and the
+// (fit_many), two cohorts' trends compared (compare_trends; at one
+// covariate, compare_trends_at; their velocities, compare_velocities), and the
 // population trend with its confidence region and each subject's distance
 // from it (population_trend).
+//
+// Parts of the trends: the fitted elements at one covariate
+// (compare_trends_at, fully invariant) and the body velocities
+// (compare_velocities, invariant under translations).
 //
 // A subject's trend is the pair (gamma(t0), gamma(t1)) of its fitted
 // geodesic at the ends of one interval [t0, t1] shared by all subjects: an
@@ -26,7 +31,9 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
+#include "bireg/geodesic.hpp"
 #include "bireg/groups/product.hpp"
+#include "bireg/groups/rn.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
@@ -161,6 +168,72 @@ template <class G, class TrendsA, class TrendsB>
 TwoSampleResult<Product<G, G>> compare_trends(
     const TrendsA& a, const TrendsB& b, const TwoSampleOptions<typename G::Scalar>& options = {}) {
   return two_sample_test<Product<G, G>>(a, b, options);
+}
+
+namespace trends_detail {
+
+// Why [t0, t1] cannot carry trends, or empty.
+template <class Scalar>
+std::string interval_refusal(Scalar t0, Scalar t1) {
+  using std::isfinite;
+  if (isfinite(t0) && isfinite(t1) && t0 < t1) return {};
+  return "the trends' interval [t0, t1] must be finite with t0 < t1, not [" + std::to_string(t0) +
+         ", " + std::to_string(t1) + "]";
+}
+
+// f(trend) for every trend of `trends`, as a vector (what two_sample_test
+// reads).
+template <class Out, class Trends, class F>
+std::vector<Out> each(const Trends& trends, F f) {
+  std::vector<Out> out;
+  out.reserve(trends.size());
+  for (std::size_t i = 0; i < trends.size(); ++i)
+    out.push_back(f(trends[i]));
+  return out;
+}
+
+}  // namespace trends_detail
+
+// The two cohorts' fitted elements at one covariate t (t = t0: the starts),
+// gamma_k(t) = g0 exp(s log(g0^{-1} g1)), s = (t - t0) / (t1 - t0), from
+// trends on [t0, t1], compared by two_sample_test on G: invariant under
+// left and right translation, inversion and exchange (docs/cohorts.md,
+// "The trends at one covariate"). t must be finite.
+template <class G, class TrendsA, class TrendsB>
+TwoSampleResult<G> compare_trends_at(const TrendsA& a, const TrendsB& b, typename G::Scalar t0,
+                                     typename G::Scalar t1, typename G::Scalar t,
+                                     const TwoSampleOptions<typename G::Scalar>& options = {}) {
+  using std::isfinite;
+  TwoSampleResult<G> refused;
+  refused.message = trends_detail::interval_refusal(t0, t1);
+  if (refused.message.empty() && !isfinite(t)) refused.message = "the covariate t is not finite";
+  if (!refused.message.empty()) return refused;
+  const auto at = [&](const Trend<G>& trend) {
+    return Geodesic<G>(trend.first, trend.second, t0, t1)(t);
+  };
+  return two_sample_test<G>(trends_detail::each<typename G::Element>(a, at),
+                            trends_detail::each<typename G::Element>(b, at), options);
+}
+
+// The two cohorts' body velocities v_k = log(g0^{-1} g1) / (t1 - t0) (per
+// covariate unit, the same at every t of a geodesic), compared as vectors
+// of the algebra by two_sample_test on R^d (the variant does not apply:
+// Ad is the identity there). Invariant under left and right translation
+// and exchange, not under inversion (docs/cohorts.md, "The velocities").
+template <class G, class TrendsA, class TrendsB>
+TwoSampleResult<Rn<G::dof, typename G::Scalar>> compare_velocities(
+    const TrendsA& a, const TrendsB& b, typename G::Scalar t0, typename G::Scalar t1,
+    const TwoSampleOptions<typename G::Scalar>& options = {}) {
+  using Velocities = Rn<G::dof, typename G::Scalar>;
+  TwoSampleResult<Velocities> refused;
+  refused.message = trends_detail::interval_refusal(t0, t1);
+  if (!refused.message.empty()) return refused;
+  const auto velocity = [&](const Trend<G>& trend) -> typename G::Tangent {
+    return Geodesic<G>(trend.first, trend.second, t0, t1).body_velocity();
+  };
+  return two_sample_test<Velocities>(trends_detail::each<typename G::Tangent>(a, velocity),
+                                     trends_detail::each<typename G::Tangent>(b, velocity),
+                                     options);
 }
 
 template <class Scalar>
