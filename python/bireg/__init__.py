@@ -11,7 +11,8 @@ counterpart.
 
 from ._bireg import __version__
 from .cohorts import (ElementwiseResult, FitManyResult, PopulationTrend, TwoSampleResult,
-                      compare_trends, fit_many, population_trend, two_sample_test)
+                      compare_trends, compare_trends_at, compare_velocities, fit_many,
+                      population_trend, two_sample_test)
 from .groups import GLp3, SE2, SE3, SL3, SO2, SO3, Group, Sim3
 from .io import read_trajectory
 from .local import LocalRegression
@@ -21,5 +22,6 @@ __all__ = [
     "__version__", "Group", "SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3",
     "GeodesicRegression", "LocalRegression", "ConvergenceWarning", "mean", "read_trajectory",
     "two_sample_test", "TwoSampleResult", "ElementwiseResult", "fit_many", "FitManyResult",
-    "compare_trends", "population_trend", "PopulationTrend",
+    "compare_trends", "compare_trends_at", "compare_velocities", "population_trend",
+    "PopulationTrend",
 ]

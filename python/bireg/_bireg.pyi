@@ -149,6 +149,16 @@ def compare_trends(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(
     bireg::compare_trends<G>: the two-sample test of two cohorts' trends in G x G.
     """
 
+def compare_trends_at(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], t0: float, t1: float, t: float, statistic: str, variant: str, permutations: int, seed: int, threads: int) -> dict:
+    """
+    bireg::compare_trends_at<G>: the two-sample test of the trends' elements at t, in G.
+    """
+
+def compare_velocities(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], t0: float, t1: float, statistic: str, permutations: int, seed: int, threads: int) -> dict:
+    """
+    bireg::compare_velocities<G>: the two-sample test of the trends' body velocities.
+    """
+
 def population_trend(group: str, trends: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], t0: float, t1: float, level: float, outlier_level: float) -> dict:
     """
     bireg::population_trend<G>: the mean trend, its confidence region, outlying subjects.

@@ -6,7 +6,8 @@ two samples of shape (m, n, n) and (k, n, n), or
 ``bireg::elementwise_two_sample_test<G>`` on subjects of K elements each,
 (m, K, n, n) and (k, K, n, n). ``fit_many`` fits each subject's geodesic
 and evaluates it on one shared interval, ``compare_trends`` tests two
-cohorts' trends in G x G, ``population_trend`` pools them. p-values come
+cohorts' trends in G x G (``compare_trends_at``: at one covariate;
+``compare_velocities``: their velocities), ``population_trend`` pools them. p-values come
 from seeded relabellings and do not depend on ``threads``.
 """
 
@@ -301,6 +302,36 @@ def compare_trends(trends_a, trends_b, group, statistic="hotelling", variant="in
     (2, n, n) and whose coordinates are 2d long."""
     plan = _trend_plan(trends_a, trends_b, group, statistic, variant, permutations, seed, threads)
     return _test_result(plan.run())
+
+
+def compare_trends_at(trends_a, trends_b, interval, t, group, statistic="hotelling",
+                      variant="invariant", permutations=9999, seed=0, threads=1):
+    """The two-sample test of the cohorts' fitted elements at covariate
+    ``t`` (``t = interval[0]``: the starts), from trends (S, 2, n, n) on
+    ``interval`` = (t0, t1) (``bireg::compare_trends_at``): invariant under
+    left and right translation, inversion and exchange. A
+    ``TwoSampleResult`` whose means are (n, n)."""
+    plan = _trend_plan(trends_a, trends_b, group, statistic, variant, permutations, seed, threads)
+    t0, t1 = _interval(interval)
+    out = _bireg.compare_trends_at(plan.group, plan.a, plan.b, t0, t1, float(t), plan.statistic,
+                                   plan.variant, plan.permutations, plan.seed, plan.threads)
+    return _test_result(out)
+
+
+def compare_velocities(trends_a, trends_b, interval, group, statistic="hotelling",
+                       permutations=9999, seed=0, threads=1):
+    """The two-sample test of the cohorts' body velocities
+    log(g0^-1 g1) / (t1 - t0), compared as vectors of the algebra
+    (``bireg::compare_velocities``): "do the cohorts move differently?",
+    whatever their starts. Invariant under left and right translation and
+    exchange, not under inversion (docs/cohorts.md). A ``TwoSampleResult``
+    whose means are velocities (d,)."""
+    plan = _trend_plan(trends_a, trends_b, group, statistic, "invariant", permutations, seed,
+                       threads)
+    t0, t1 = _interval(interval)
+    out = _bireg.compare_velocities(plan.group, plan.a, plan.b, t0, t1, plan.statistic,
+                                    plan.permutations, plan.seed, plan.threads)
+    return _test_result(out)
 
 
 def population_trend(trends, interval, group, level=0.95, outlier_level=0.999):

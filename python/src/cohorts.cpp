@@ -290,6 +290,34 @@ nb::dict compare_trends_dict(const Trends& a, const Trends& b,
   return test_dict(result, [](const bireg::Trend<G>& mean) { return trend_array<G>(mean); });
 }
 
+// The trends' elements at covariate t, compared in G: a dict whose means
+// are matrices.
+template <class G>
+nb::dict compare_trends_at_dict(const Trends& a, const Trends& b, double t0, double t1, double t,
+                                const bireg::TwoSampleOptions<double>& options) {
+  bireg::TwoSampleResult<G> result;
+  {
+    nb::gil_scoped_release release;
+    result = bireg::compare_trends_at<G>(TrendView<G>(a), TrendView<G>(b), t0, t1, t, options);
+  }
+  if (!result.ok()) refuse("compare_trends_at: " + result.message);
+  return test_dict(result, [](const typename G::Element& mean) { return matrix_array(mean); });
+}
+
+// The trends' body velocities, compared as vectors: a dict whose means are
+// vectors of length d.
+template <class G>
+nb::dict compare_velocities_dict(const Trends& a, const Trends& b, double t0, double t1,
+                                 const bireg::TwoSampleOptions<double>& options) {
+  bireg::TwoSampleResult<bireg::Rn<G::dof, double>> result;
+  {
+    nb::gil_scoped_release release;
+    result = bireg::compare_velocities<G>(TrendView<G>(a), TrendView<G>(b), t0, t1, options);
+  }
+  if (!result.ok()) refuse("compare_velocities: " + result.message);
+  return test_dict(result, [](const typename G::Tangent& mean) { return vector_array(mean); });
+}
+
 template <class G>
 nb::dict population_trend_dict(const Trends& trends, double t0, double t1, double level,
                                double outlier_level) {
@@ -403,6 +431,32 @@ void bind_cohorts(nb::module_& m) {
       nb::arg("permutations"), nb::arg("seed"), nb::arg("threads"),
       nb::arg("first_permutation") = 0,
       "bireg::compare_trends<G>: the two-sample test of two cohorts' trends in G x G.");
+  m.def(
+      "compare_trends_at",
+      [](const std::string& group, const Trends& a, const Trends& b, double t0, double t1, double t,
+         const std::string& statistic, const std::string& variant, int permutations,
+         std::uint64_t seed, int threads) {
+        const auto options = test_options(statistic, variant, permutations, seed, threads);
+        return with_trend_group(group, "compare_trends_at", [&](auto tag) {
+          return compare_trends_at_dict<typename decltype(tag)::type>(a, b, t0, t1, t, options);
+        });
+      },
+      nb::arg("group"), nb::arg("a"), nb::arg("b"), nb::arg("t0"), nb::arg("t1"), nb::arg("t"),
+      nb::arg("statistic"), nb::arg("variant"), nb::arg("permutations"), nb::arg("seed"),
+      nb::arg("threads"),
+      "bireg::compare_trends_at<G>: the two-sample test of the trends' elements at t, in G.");
+  m.def(
+      "compare_velocities",
+      [](const std::string& group, const Trends& a, const Trends& b, double t0, double t1,
+         const std::string& statistic, int permutations, std::uint64_t seed, int threads) {
+        const auto options = test_options(statistic, "invariant", permutations, seed, threads);
+        return with_trend_group(group, "compare_velocities", [&](auto tag) {
+          return compare_velocities_dict<typename decltype(tag)::type>(a, b, t0, t1, options);
+        });
+      },
+      nb::arg("group"), nb::arg("a"), nb::arg("b"), nb::arg("t0"), nb::arg("t1"),
+      nb::arg("statistic"), nb::arg("permutations"), nb::arg("seed"), nb::arg("threads"),
+      "bireg::compare_velocities<G>: the two-sample test of the trends' body velocities.");
   m.def(
       "population_trend",
       [](const std::string& group, const Trends& trends, double t0, double t1, double level,

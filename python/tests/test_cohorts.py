@@ -359,3 +359,40 @@ def test_population_trend_against_its_definition(rng):
     assert population.outlying.dtype == bool and population.outlying.shape == (30,)
     with pytest.raises(ValueError, match="population_trend"):
         bireg.population_trend(trends[:5], (0.0, 2.0), group="SO3")
+
+
+def test_velocities_and_trends_at_one_covariate(rng):
+    start = bireg.SO3.exp(np.array([0.2, 0.1, -0.1]))
+    a = bireg.fit_many(subjects_about(start, np.array([0.4, 0.0, 0.1]), 15, rng, spread=0.2),
+                       group="SO3", interval=(0.0, 2.0)).trends
+    b = bireg.fit_many(subjects_about(start, np.array([0.4, 0.3, 0.1]), 17, rng, spread=0.2),
+                       group="SO3", interval=(0.0, 2.0)).trends
+    # The velocities' T^2, computed here from its definition: v = log(g0^T g1) / 2,
+    # Euclidean means and covariances (divisors m and n), pooled.
+    va = bireg.SO3.log(np.einsum("sji,sjk->sik", a[:, 0], a[:, 1])) / 2.0
+    vb = bireg.SO3.log(np.einsum("sji,sjk->sik", b[:, 0], b[:, 1])) / 2.0
+    m, n = len(va), len(vb)
+    c = vb.mean(0) - va.mean(0)
+    s_a = np.cov(va.T, bias=True)
+    s_b = np.cov(vb.T, bias=True)
+    pooled = (m * s_a + n * s_b) / (m + n - 2)
+    t2 = m * n / (m + n) * c @ np.linalg.solve(pooled, c)
+    velocities = bireg.compare_velocities(a, b, (0.0, 2.0), group="SO3", permutations=999,
+                                          seed=1)
+    assert velocities.value == pytest.approx(t2, rel=1e-10)
+    assert np.allclose(velocities.mean_a, va.mean(0), atol=1e-13)
+    assert velocities.p_value <= 0.01  # a velocity 0.3 apart, spread 0.2 / 2 per unit
+    # Left translation leaves the velocities unchanged: the same test.
+    h = bireg.SO3.exp(np.array([1.0, -0.5, 0.2]))
+    moved = bireg.compare_velocities(bireg.SO3.compose(h, a), bireg.SO3.compose(h, b),
+                                     (0.0, 2.0), group="SO3", permutations=999, seed=1)
+    assert moved.value == pytest.approx(velocities.value, rel=1e-9)
+    assert moved.p_value == velocities.p_value
+    # At t0 the test of the trends is the test of their starts.
+    at_start = bireg.compare_trends_at(a, b, (0.0, 2.0), 0.0, group="SO3", permutations=199)
+    starts = bireg.two_sample_test(a[:, 0], b[:, 0], group="SO3", permutations=199)
+    assert at_start.value == starts.value and at_start.p_value == starts.p_value
+    with pytest.raises(ValueError, match="compare_velocities: .*t0 < t1"):
+        bireg.compare_velocities(a, b, (2.0, 0.0), group="SO3")
+    with pytest.raises(ValueError, match="SO3, SE3"):
+        bireg.compare_trends_at(a, b, (0.0, 2.0), 1.0, group="SL3")
