@@ -24,12 +24,15 @@ function's result type:
 
 A task is a pure function of its arguments, so a task whose worker died is
 run again by Dask with the same result. Workers print nothing: progress is
-Dask's own (the dashboard, or ``distributed.progress`` on futures). On a
+Dask's own dashboard (the calls block until the result is joined). On a
 real cluster only the client changes (``distributed.Client(address)``,
-dask-jobqueue's ``SLURMCluster``, dask-kubernetes); docs/distributed.md
-says how the cost scales.
+dask-jobqueue's ``SLURMCluster``, dask-kubernetes, scaled to its workers
+first); docs/distributed.md says how the cost scales. When several blocks
+fail, the error raised is one of theirs, not necessarily the first in
+cohort order as the local function's is.
 """
 
+import importlib.metadata
 from dataclasses import replace
 
 import numpy as np
@@ -60,21 +63,17 @@ def _client(client):
                          "(distributed.Client(...)) or pass client=") from None
 
 
-def _worker_version():
-    """Run on each worker: bireg's version there, or why it cannot be imported."""
-    try:
-        import bireg
-    except ImportError as error:
-        return f"bireg cannot be imported ({error})"
-    return bireg.__version__
-
-
 def _check_workers(client):
-    """RuntimeError naming the workers that lack bireg or have another version."""
-    versions = client.run(_worker_version)
+    """RuntimeError naming the workers that lack bireg or have another
+    version than the client's. The version is read from the installed
+    package's metadata by a standard-library function, so that the check
+    itself needs nothing of bireg on the workers."""
+    versions = client.run(importlib.metadata.version, "bireg", on_error="return")
     if not versions:
-        raise RuntimeError("the Dask client has no workers")
-    wrong = {worker: found for worker, found in versions.items() if found != __version__}
+        raise RuntimeError("the Dask client has no workers yet (scale the cluster, or "
+                           "client.wait_for_workers(n), first)")
+    wrong = {worker: ("bireg is not installed" if isinstance(found, Exception) else found)
+             for worker, found in versions.items() if found != __version__}
     if wrong:
         listed = "; ".join(f"{worker}: {found}" for worker, found in sorted(wrong.items()))
         raise RuntimeError(f"every worker needs bireg {__version__}, as the client has; "
@@ -131,9 +130,11 @@ def two_sample_test(A, B, group, statistic="hotelling", variant="invariant", per
     if plan.elements == 0:
         shares = _gather(client, _test_share, plan, _blocks(plan.permutations, blocks, workers))
         return _cohorts._test_result(combine_two_sample(plan.group, shares))
-    # Each worker is sent its own slice of the elements, for all subjects.
-    futures = [client.submit(_map_slice, client.scatter(plan.slice(first, size), hash=False),
-                             pure=False)
+    # Each worker is sent its own slice of the elements, for all subjects,
+    # inside its task (not scattered: a task's own arguments let Dask rerun
+    # it when its worker dies; scattered data held by one worker would be
+    # lost with it).
+    futures = [client.submit(_map_slice, plan.slice(first, size), pure=False)
                for first, size in _blocks(plan.elements, blocks, workers)]
     return _cohorts._map_result(combine_elementwise(plan.group, client.gather(futures)))
 

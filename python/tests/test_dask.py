@@ -3,6 +3,7 @@ local function's exactly, whatever the number of workers and blocks; a
 worker that dies mid-computation changes nothing; bad data are refused with
 the index the local function gives."""
 
+import importlib.metadata
 import os
 import signal
 import threading
@@ -74,8 +75,8 @@ def workers(client, count):
             kwargs.pop("broadcast", None)
             return client.scatter(data, workers=addresses, broadcast=True, **kwargs)
 
-        def run(self, function, **kwargs):
-            return client.run(function, workers=addresses, **kwargs)
+        def run(self, function, *args, **kwargs):
+            return client.run(function, *args, workers=addresses, **kwargs)
 
     return Restricted()
 
@@ -137,7 +138,7 @@ def test_a_map_of_dask_arrays_is_computed_slice_by_slice_on_the_workers(client, 
 def test_fit_many_and_compare_trends_are_the_local_ones(client, rng):
     velocity = np.array([0.3, 0.1, -0.2, 0.5, 0.0, 0.1])
     cohort_a = subjects(rng, 13, velocity)
-    cohort_b = subjects(rng, 14, velocity + np.array([0.0, 0.15, 0, 0, 0, 0]))
+    cohort_b = subjects(rng, 14, velocity + np.array([0.0, 0.02, 0, 0, 0, 0]))
     for blocks in (1, 4, 13):
         for interval in (None, (0.0, 2.0)):
             local = bireg.fit_many(cohort_a, group="SE3", interval=interval)
@@ -146,6 +147,7 @@ def test_fit_many_and_compare_trends_are_the_local_ones(client, rng):
     a = bireg.fit_many(cohort_a, group="SE3", interval=(0.0, 2.0)).trends
     b = bireg.fit_many(cohort_b, group="SE3", interval=(0.0, 2.0)).trends
     local = bireg.compare_trends(a, b, group="SE3", permutations=299, seed=11)
+    assert 0 < local.at_least_as_extreme < 299  # a wrong share offset would move it
     for blocks in (1, 7):
         same(bireg.dask.compare_trends(a, b, group="SE3", permutations=299, seed=11,
                                        client=client, blocks=blocks), local)
@@ -167,12 +169,12 @@ def test_fit_many_takes_a_bag_of_subjects(client, rng):
                             client=client)
 
 
-def test_workers_without_the_clients_bireg_are_named():
+def test_workers_without_the_clients_bireg_are_named(client):
     class Cluster:
         def __init__(self, versions):
             self.versions = versions
 
-        def run(self, function):
+        def run(self, function, *args, **kwargs):
             return self.versions
 
     with pytest.raises(RuntimeError, match="tcp://b:1: 0.0.1"):
@@ -180,9 +182,15 @@ def test_workers_without_the_clients_bireg_are_named():
                                    group="SO3", permutations=9,
                                    client=Cluster({"tcp://a:1": bireg.__version__,
                                                    "tcp://b:1": "0.0.1"}))
-    with pytest.raises(RuntimeError, match="cannot be imported"):
+    missing = ModuleNotFoundError("No package metadata was found for bireg")
+    with pytest.raises(RuntimeError, match="tcp://a:1: bireg is not installed"):
         bireg.dask.fit_many([(np.arange(3.0), np.stack([np.eye(3)] * 3))], group="SO3",
-                            client=Cluster({"tcp://a:1": "bireg cannot be imported (x)"}))
+                            client=Cluster({"tcp://a:1": missing}))
+    with pytest.raises(RuntimeError, match="no workers yet"):
+        bireg.dask.fit_many([(np.arange(3.0), np.stack([np.eye(3)] * 3))], group="SO3",
+                            client=Cluster({}))
+    # On the real cluster, the check reads every worker's installed bireg.
+    assert set(client.run(importlib.metadata.version, "bireg").values()) == {bireg.__version__}
 
 
 def test_bad_data_are_refused_with_the_local_index(client, rng):
@@ -207,28 +215,38 @@ def test_bad_data_are_refused_with_the_local_index(client, rng):
         bireg.dask.two_sample_test(A, B, group="SO3", permutations=9, client=client, blocks=0)
 
 
-def test_a_worker_killed_mid_test_changes_nothing(client, rng):
-    """Runs last: the cluster then has a new worker in place of the killed one."""
-    a = rotations(rng, 40, np.eye(3))
-    b = rotations(rng, 40, bireg.SO3.exp(np.array([0.05, 0.0, 0.0])))
-    local = bireg.two_sample_test(a, b, group="SO3", permutations=30000, seed=5)
+@pytest.mark.parametrize("kind", ["relabellings", "map"])
+def test_a_worker_killed_mid_test_changes_nothing(client, rng, kind):
+    """Runs last: the cluster then has new workers in place of the killed ones."""
+    if kind == "relabellings":
+        a = rotations(rng, 40, np.eye(3))
+        b = rotations(rng, 40, bireg.SO3.exp(np.array([0.05, 0.0, 0.0])))
+        arguments = dict(group="SO3", permutations=30000, seed=5)
+    else:  # slices of elements, each sent inside its own task
+        a = rotations(rng, 30 * 12, np.eye(3)).reshape(30, 12, 3, 3)
+        b = rotations(rng, 30 * 12, np.eye(3)).reshape(30, 12, 3, 3)
+        arguments = dict(group="SO3", permutations=3000, seed=5, mode="exact")
+    local = bireg.two_sample_test(a, b, **arguments)
+    client.wait_for_workers(3, timeout=60)
     victim = sorted(client.scheduler_info()["workers"])[0]
     pid = client.run(os.getpid, workers=[victim])[victim]
     outcome = {}
 
     def spread():
-        outcome["result"] = bireg.dask.two_sample_test(a, b, group="SO3", permutations=30000,
-                                                       seed=5, client=client, blocks=12)
+        outcome["result"] = bireg.dask.two_sample_test(a, b, client=client, blocks=12,
+                                                       **arguments)
 
     thread = threading.Thread(target=spread)
     thread.start()
-    # Kill the victim's process (SIGKILL: no clean shutdown) once it is
-    # running a block; its nanny starts a new worker and Dask reruns the
-    # lost blocks elsewhere.
+    # Kill the victim's process (SIGKILL: no clean shutdown) while it runs a
+    # block; its nanny starts a new worker and Dask reruns the lost blocks.
     deadline = time.monotonic() + 60
-    while not client.processing(workers=[victim]).get(victim) and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert client.processing(workers=[victim]).get(victim), "the victim never ran a block"
+    running = False
+    while not running and time.monotonic() < deadline:
+        running = bool(client.processing(workers=[victim]).get(victim))
+        if not running:
+            time.sleep(0.005)
+    assert running, "the victim never ran a block"
     os.kill(pid, signal.SIGKILL)
     thread.join(timeout=180)
     assert not thread.is_alive()

@@ -21,7 +21,7 @@ def test_readme_python_block_runs(index, monkeypatch):
     if "distributed" in code:
         pytest.importorskip("distributed")
     monkeypatch.chdir(ROOT)
-    namespace = {"__name__": f"readme_block_{index}"}
+    namespace = {"__name__": "__main__"}  # as `python block.py` runs it
     try:
         exec(compile(code, f"README.md python block {index}", "exec"), namespace)
     finally:

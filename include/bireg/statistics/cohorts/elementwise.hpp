@@ -323,7 +323,9 @@ ElementwiseResult<G> elementwise_two_sample_test(
 // concatenated, max_k T_kb is taken over the slices and the family-wise
 // and q-values are computed over all elements, so the result equals the
 // map of all elements at once exactly. Refused (invalid_input) unless
-// every slice ran with the same relabellings.
+// every slice ran and holds the same number of relabellings; the seed and
+// the statistic are not recorded, so the caller runs every slice with the
+// same options (bireg.dask does).
 template <class G>
 ElementwiseResult<G> combine_elementwise(const std::vector<ElementwiseResult<G>>& slices) {
   ElementwiseResult<G> result;

@@ -495,7 +495,9 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
 // p recomputed, the rest is the first share's. Refused (invalid_input, the
 // message says why) unless every share ran, they agree on the statistic,
 // variant and observed value (the same data and build), and their
-// relabellings tile 0 .. B - 1 without gap or overlap.
+// relabellings tile 0 .. B - 1 without gap or overlap. The seed is not
+// recorded: the caller runs every share with the same options (bireg.dask
+// does; over MPI, give every rank the same TwoSampleOptions).
 template <class G>
 TwoSampleResult<G> combine_two_sample(const std::vector<TwoSampleResult<G>>& shares) {
   using Scalar = typename G::Scalar;
