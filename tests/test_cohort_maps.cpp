@@ -251,6 +251,13 @@ TEST_CASE("An element-wise map computed in slices of elements combines exactly",
     const auto other = bireg::elementwise_two_sample_test<bireg::SO3d>(
         a, std::size_t(m), b, std::size_t(n), std::size_t(elements), fewer);
     CHECK(!bireg::combine_elementwise<bireg::SO3d>({slice(0, 10), other}).ok());
+    // Nor slices of another seed or statistic.
+    auto reseeded = slice(10, 20);
+    reseeded.seed += 1;
+    CHECK(!bireg::combine_elementwise<bireg::SO3d>({slice(0, 10), reseeded}).ok());
+    auto restated = slice(10, 20);
+    restated.statistic = bireg::TwoSampleStatistic::hotelling;
+    CHECK(!bireg::combine_elementwise<bireg::SO3d>({slice(0, 10), restated}).ok());
   }
 }
 

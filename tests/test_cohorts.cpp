@@ -266,6 +266,17 @@ TEST_CASE("A test shared out in relabelling blocks combines to the whole test",
     CHECK(!other.ok());
     CHECK(other.message.find("different data") != std::string::npos);
     CHECK(!bireg::combine_two_sample<G>({}).ok());
+    auto reseeded = options;
+    reseeded.seed = options.seed + 1;
+    reseeded.first_permutation = 100;
+    reseeded.permutations = 233;
+    const auto other_seed =
+        bireg::combine_two_sample<G>({shares[1], bireg::two_sample_test<G>(a, b, reseeded)});
+    CHECK(!other_seed.ok());
+    CHECK(other_seed.message.find("seed") != std::string::npos);
+    auto inconsistent = shares[0];
+    inconsistent.at_least_as_extreme = inconsistent.permutations + 1;
+    CHECK(!bireg::combine_two_sample<G>({shares[1], shares[2], inconsistent}).ok());
   }
   auto too_far = options_for(TwoSampleStatistic::hotelling, 10);
   too_far.first_permutation = bireg::kMaxTwoSamplePermutations - 5;

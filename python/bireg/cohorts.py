@@ -145,13 +145,14 @@ def _plan(A, B, group, statistic, variant, permutations, seed, threads, mode):
 def _test_result(out):
     """A TwoSampleResult from the binding's dict (which also says which
     relabellings it ran, for joining shares)."""
-    return TwoSampleResult(**{k: v for k, v in out.items() if k != "first_permutation"})
+    internal = ("first_permutation", "seed")
+    return TwoSampleResult(**{k: v for k, v in out.items() if k not in internal})
 
 
 def _map_result(out):
     """An ElementwiseResult from the binding's dict (which also carries the
     per-relabelling maxima, for joining slices)."""
-    internal = ("ranked_value", "relabelling_maximum")
+    internal = ("ranked_value", "relabelling_maximum", "seed")
     return ElementwiseResult(**{k: v for k, v in out.items() if k not in internal})
 
 

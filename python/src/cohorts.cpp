@@ -49,6 +49,7 @@ nb::dict test_dict(const bireg::TwoSampleResult<G>& result, const WriteElement& 
   out["variant"] = std::string(to_string(result.variant));
   out["value"] = result.value;
   out["p_value"] = result.p_value;
+  out["seed"] = result.seed;
   out["first_permutation"] = result.first_permutation;
   out["permutations"] = result.permutations;
   out["at_least_as_extreme"] = result.at_least_as_extreme;
@@ -98,6 +99,7 @@ nb::dict elementwise(const Stack& a, std::size_t m, const Stack& b, std::size_t 
   out["failed_permutations"] = result.failed_permutations;
   out["ranked_value"] = vector_array(result.ranked_value);
   out["relabelling_maximum"] = vector_array(result.relabelling_maximum);
+  out["seed"] = result.seed;
   return out;
 }
 
@@ -128,6 +130,7 @@ nb::dict combine_two_sample(const std::vector<nb::dict>& shares) {
     r.statistic = options.statistic;
     r.variant = options.variant;
     r.value = entry<double>(shares[s], "value", s);
+    r.seed = entry<std::uint64_t>(shares[s], "seed", s);
     r.first_permutation = entry<std::uint64_t>(shares[s], "first_permutation", s);
     r.permutations = entry<int>(shares[s], "permutations", s);
     r.at_least_as_extreme = entry<int>(shares[s], "at_least_as_extreme", s);
@@ -156,6 +159,13 @@ nb::dict combine_elementwise(const std::vector<nb::dict>& slices) {
   for (std::size_t s = 0; s < slices.size(); ++s) {
     bireg::ElementwiseResult<G>& r = results[s];
     r.status = bireg::Status::converged;
+    const auto options = test_options(entry<std::string>(slices[s], "statistic", s),
+                                      entry<std::string>(slices[s], "variant", s), 0, 0, 1);
+    r.statistic = options.statistic;
+    r.mode =
+        parse_choice(entry<std::string>(slices[s], "mode", s),
+                     {bireg::ElementwiseMode::exact, bireg::ElementwiseMode::linearised}, "mode");
+    r.seed = entry<std::uint64_t>(slices[s], "seed", s);
     r.value = array_entry(slices[s], "value", s);
     r.p_value = array_entry(slices[s], "p_value", s);
     r.ranked_value = array_entry(slices[s], "ranked_value", s);
@@ -177,6 +187,7 @@ nb::dict combine_elementwise(const std::vector<nb::dict>& slices) {
   out["failed_permutations"] = whole.failed_permutations;
   out["ranked_value"] = vector_array(whole.ranked_value);
   out["relabelling_maximum"] = vector_array(whole.relabelling_maximum);
+  out["seed"] = whole.seed;
   return out;
 }
 

@@ -396,3 +396,21 @@ def test_velocities_and_trends_at_one_covariate(rng):
         bireg.compare_velocities(a, b, (2.0, 0.0), group="SO3")
     with pytest.raises(ValueError, match="SO3, SE3"):
         bireg.compare_trends_at(a, b, (0.0, 2.0), 1.0, group="SL3")
+
+
+def test_shares_of_a_test_join_only_when_they_are_one_test(rng):
+    from bireg import _bireg
+
+    a = bireg.SO3.exp(0.3 * rng.standard_normal((12, 3)))
+    b = bireg.SO3.exp(0.3 * rng.standard_normal((13, 3)) + [0.2, 0.0, 0.0])
+    plan = bireg.cohorts._plan(a, b, "SO3", "hotelling", "invariant", 300, 4, 1, "exact")
+    whole = plan.run_test()
+    shares = [plan.run_test(200, 100), plan.run_test(0, 200)]
+    joined = _bireg.combine_two_sample("SO3", shares)
+    assert joined["p_value"] == whole["p_value"]
+    assert joined["at_least_as_extreme"] == whole["at_least_as_extreme"]
+    other_seed = bireg.cohorts._plan(a, b, "SO3", "hotelling", "invariant", 300, 5, 1, "exact")
+    with pytest.raises(ValueError, match="seed"):
+        _bireg.combine_two_sample("SO3", [plan.run_test(0, 200), other_seed.run_test(200, 100)])
+    with pytest.raises(ValueError, match="do not tile"):
+        _bireg.combine_two_sample("SO3", [plan.run_test(0, 200), plan.run_test(150, 150)])

@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -79,6 +80,10 @@ struct ElementwiseResult {
   // relabelling b (failed statistics count as +inf).
   std::vector<Scalar> ranked_value;
   std::vector<Scalar> relabelling_maximum;
+  // What the slices of one map must share (combine_elementwise checks).
+  TwoSampleStatistic statistic = TwoSampleStatistic::hotelling;
+  ElementwiseMode mode = ElementwiseMode::linearised;
+  std::uint64_t seed = 0;
 
   bool ok() const { return is_success(status); }
 };
@@ -313,6 +318,9 @@ ElementwiseResult<G> elementwise_two_sample_test(
   elementwise_detail::adjust_for_multiplicity(result);
   result.permutations = test.permutations;
   result.failed_permutations = failed;
+  result.statistic = test.statistic;
+  result.mode = options.mode;
+  result.seed = test.seed;
   result.status = Status::converged;
   return result;
 }
@@ -323,9 +331,8 @@ ElementwiseResult<G> elementwise_two_sample_test(
 // concatenated, max_k T_kb is taken over the slices and the family-wise
 // and q-values are computed over all elements, so the result equals the
 // map of all elements at once exactly. Refused (invalid_input) unless
-// every slice ran and holds the same number of relabellings; the seed and
-// the statistic are not recorded, so the caller runs every slice with the
-// same options (bireg.dask does).
+// every slice ran with the same statistic, mode, seed and number of
+// relabellings.
 template <class G>
 ElementwiseResult<G> combine_elementwise(const std::vector<ElementwiseResult<G>>& slices) {
   ElementwiseResult<G> result;
@@ -342,6 +349,13 @@ ElementwiseResult<G> combine_elementwise(const std::vector<ElementwiseResult<G>>
       return result;
     }
     const std::size_t k = slice.elements;
+    if (slice.statistic != slices.front().statistic || slice.mode != slices.front().mode ||
+        slice.seed != slices.front().seed) {
+      result.message = "slice " + std::to_string(s) +
+                       " was run with another statistic, mode or seed than slice 0: they are not "
+                       "slices of one map";
+      return result;
+    }
     if (slice.permutations != slices.front().permutations ||
         slice.relabelling_maximum.size() != count || slice.value.size() != k ||
         slice.ranked_value.size() != k || slice.p_value.size() != k) {
@@ -362,6 +376,9 @@ ElementwiseResult<G> combine_elementwise(const std::vector<ElementwiseResult<G>>
   }
   result.elements = result.value.size();
   result.permutations = slices.front().permutations;
+  result.statistic = slices.front().statistic;
+  result.mode = slices.front().mode;
+  result.seed = slices.front().seed;
   elementwise_detail::adjust_for_multiplicity(result);
   result.status = Status::converged;
   return result;

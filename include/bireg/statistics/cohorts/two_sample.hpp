@@ -118,6 +118,7 @@ struct TwoSampleResult {
   TwoSampleVariant variant = TwoSampleVariant::invariant;
   Scalar value = 0;  // T^2, D_B or H^2 of the data
   Scalar p_value = 1;
+  std::uint64_t seed = 0;               // of the relabellings
   std::uint64_t first_permutation = 0;  // this result's relabellings: first_permutation ..
   int permutations = 0;                 // .. first_permutation + permutations - 1
   int at_least_as_extreme = 0;          // #{b : T_b >= T}, failed relabellings included
@@ -480,6 +481,7 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
     result.failed_permutations += verdict == detail::Verdict::failed ? 1 : 0;
     result.at_least_as_extreme += verdict == detail::Verdict::less_extreme ? 0 : 1;
   }
+  result.seed = options.seed;
   result.first_permutation = options.first_permutation;
   result.permutations = options.permutations;
   result.p_value = permutation_p_value<Scalar>(result.at_least_as_extreme, options.permutations);
@@ -495,9 +497,8 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
 // p recomputed, the rest is the first share's. Refused (invalid_input, the
 // message says why) unless every share ran, they agree on the statistic,
 // variant and observed value (the same data and build), and their
-// relabellings tile 0 .. B - 1 without gap or overlap. The seed is not
-// recorded: the caller runs every share with the same options (bireg.dask
-// does; over MPI, give every rank the same TwoSampleOptions).
+// relabellings tile 0 .. B - 1 without gap or overlap, with the same seed
+// and consistent counts (0 <= failed <= at least as extreme <= B_s).
 template <class G>
 TwoSampleResult<G> combine_two_sample(const std::vector<TwoSampleResult<G>>& shares) {
   using Scalar = typename G::Scalar;
@@ -523,6 +524,20 @@ TwoSampleResult<G> combine_two_sample(const std::vector<TwoSampleResult<G>>& sha
   long long at_least = 0, failed = 0, total = 0;
   for (const std::size_t s : order) {
     const TwoSampleResult<G>& share = shares[s];
+    if (share.permutations < 0 || share.failed_permutations < 0 ||
+        share.failed_permutations > share.at_least_as_extreme ||
+        share.at_least_as_extreme > share.permutations) {
+      refused.message = "share " + std::to_string(s) +
+                        " has inconsistent counts (it needs 0 <= failed <= at least as extreme "
+                        "<= permutations)";
+      return refused;
+    }
+    if (share.seed != first.seed) {
+      refused.message = "share " + std::to_string(s) + " was run with seed " +
+                        std::to_string(share.seed) + ", another share with seed " +
+                        std::to_string(first.seed) + ": they are not shares of one test";
+      return refused;
+    }
     if (share.statistic != first.statistic || share.variant != first.variant ||
         !(share.value == first.value)) {
       refused.message = "share " + std::to_string(s) +
