@@ -36,3 +36,20 @@ def positive_int(value, name):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise ValueError(f"{name} must be an integer, got {value!r}")
     return int(value)
+
+
+def seed(value):
+    """A relabelling seed: an integer from 0 to 2^64 - 1."""
+    value = positive_int(value, "seed")
+    if value < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {value}")
+    return value
+
+
+def subject_pair(subject, index):
+    """(t, Y) of subject `index`, or ValueError naming it."""
+    try:
+        t, Y = subject
+    except (TypeError, ValueError):
+        raise ValueError(f"subject {index} must be a pair (t, Y)") from None
+    return t, Y

@@ -115,9 +115,7 @@ def _plan(A, B, group, statistic, variant, permutations, seed, threads, mode):
     a = np.ascontiguousarray(A, dtype=np.float64)
     b = np.ascontiguousarray(B, dtype=np.float64)
     permutations = _arrays.positive_int(permutations, "permutations")
-    seed = _arrays.positive_int(seed, "seed")
-    if seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    seed = _arrays.seed(seed)
     threads = _arrays.positive_int(threads, "threads")
     if a.ndim == 3 and b.ndim == 3:
         a = _arrays.matrices(a, n, "A")
@@ -224,10 +222,7 @@ def _subject_arrays(subjects, g, first_subject=0):
     """Each subject's (t, Y) as the binding's arrays, named by cohort index."""
     t_list, y_list = [], []
     for i, subject in enumerate(subjects, start=first_subject):
-        try:
-            t, Y = subject
-        except (TypeError, ValueError):
-            raise ValueError(f"subject {i} must be a pair (t, Y)") from None
+        t, Y = _arrays.subject_pair(subject, i)
         t_list.append(_arrays.covariates(t, f"subject {i}'s t"))
         y_list.append(_arrays.matrices(Y, g.matrix_size, f"subject {i}'s Y"))
     return t_list, y_list
@@ -286,9 +281,7 @@ class _TrendPlan:
 
 def _trend_plan(trends_a, trends_b, group, statistic, variant, permutations, seed, threads):
     g = _groups.get(group)
-    seed = _arrays.positive_int(seed, "seed")
-    if seed < 0:
-        raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    seed = _arrays.seed(seed)
     return _TrendPlan(g.name, _trends(trends_a, g.matrix_size, "trends_a"),
                       _trends(trends_b, g.matrix_size, "trends_b"), statistic, variant,
                       _arrays.positive_int(permutations, "permutations"), seed,

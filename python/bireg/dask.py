@@ -196,7 +196,7 @@ def _covariate_range(subjects, first=0):
     local fit_many's default interval, found over blocks."""
     low, high = np.inf, -np.inf
     for i, subject in enumerate(subjects, start=first):
-        t = _arrays.covariates(_pair(subject, i)[0], f"subject {i}'s t")
+        t = _arrays.covariates(_arrays.subject_pair(subject, i)[0], f"subject {i}'s t")
         t = t[np.isfinite(t)]
         if t.size:
             low, high = min(low, float(t.min())), max(high, float(t.max()))
@@ -239,7 +239,7 @@ def fit_many(subjects, group, interval=None, threads=1, client=None, blocks=None
         return _fit_many_bag(subjects, g.name, interval, threads, client)
     pairs = []
     for i, subject in enumerate(subjects):
-        t, Y = _pair(subject, i)
+        t, Y = _arrays.subject_pair(subject, i)
         pairs.append((_arrays.covariates(t, f"subject {i}'s t"), np.asarray(Y)))
     if not pairs:
         raise ValueError("fit_many: there are no subjects")
@@ -281,11 +281,3 @@ def _fit_many_bag(bag, group, interval, threads, client):
     fits = client.compute([dask.delayed(_fit_subjects)(p, first, group, t0, t1, threads)
                            for p, first in used])
     return _join_fits(client.gather(fits))
-
-
-def _pair(subject, index):
-    try:
-        t, Y = subject
-    except (TypeError, ValueError):
-        raise ValueError(f"subject {index} must be a pair (t, Y)") from None
-    return t, Y
