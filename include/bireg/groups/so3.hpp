@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
@@ -45,8 +46,23 @@ struct SO3 {
   // R = I + (sin t / t) W + ((1 - cos t)/t^2) W^2, W = hat(omega), t = |omega|.
   static Element exp(const Tangent& omega) {
     using std::sqrt;
-    const RodriguesCoefficients c = rodrigues_coefficients(sqrt(omega.squaredNorm()));
+    const Scalar squared_angle = omega.squaredNorm();
+    if (!(squared_angle <= std::numeric_limits<Scalar>::max())) return exp_of_huge(omega);
+    const RodriguesCoefficients c = rodrigues_coefficients(sqrt(squared_angle));
     return rodrigues(omega, c.sin_over_angle, c.one_minus_cos_over_angle2);
+  }
+
+  // An angle whose square overflows (a geodesic evaluated ~1e154 ranges
+  // away from its data): the same rotation about the unit axis u, R = I +
+  // sin t hat(u) + (1 - cos t) hat(u)^2, which stays a rotation; NaN only
+  // for a tangent that is not finite.
+  static Element exp_of_huge(const Tangent& omega) {
+    using std::cos;
+    using std::sin;
+    if (!omega.allFinite()) return Element::Constant(std::numeric_limits<Scalar>::quiet_NaN());
+    const Scalar angle = omega.stableNorm();
+    const Tangent axis = omega / angle;
+    return rodrigues(axis, sin(angle), Scalar(1) - cos(angle));
   }
 
   // With h = t/2: sin t / t = sinc(h) cos(h) and (1 - cos t)/t^2 = sinc(h)^2/2,

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -54,6 +55,25 @@ struct Problem {
   std::size_t size() const { return t.size(); }
   Scalar determinant() const { return a * c - b * b; }
 };
+
+// The smallest covariate range (max - min) fit() accepts; the largest is
+// its inverse. The velocity is X / range (X on the unit interval): beyond
+// these it would overflow or underflow out of the normal numbers.
+// min normal / epsilon: 1e-292 in double, 1e-31 in float.
+template <class Scalar>
+CovariateScalar<Scalar> covariate_range_limit() {
+  using Wide = CovariateScalar<Scalar>;
+  return Wide(std::numeric_limits<Scalar>::min()) / Wide(std::numeric_limits<Scalar>::epsilon());
+}
+
+// The same for the velocity's covariance, C / range^2: its square root,
+// 1e-146 in double, 3e-16 in float (statistics/covariance.hpp refuses a
+// covariance outside it as undefined; the fit itself stands).
+template <class Scalar>
+CovariateScalar<Scalar> covariance_range_limit() {
+  using std::sqrt;
+  return sqrt(covariate_range_limit<Scalar>());
+}
 
 namespace problem_detail {
 template <class Scalar>
@@ -123,6 +143,16 @@ std::optional<Rejection> make_problem(
     return Rejection{range > 0 ? "covariate range overflows"
                                : "all covariates are equal: the slope is not identifiable"};
   }
+  // The velocity is X / range (X on the unit interval): a range outside
+  // covariate_range_limit would make it overflow or underflow.
+  const Wide smallest_range = covariate_range_limit<Scalar>();
+  if (range < smallest_range || range > 1 / smallest_range) {
+    std::ostringstream why;
+    why << "the covariates' range " << double(range) << " lies outside [" << double(smallest_range)
+        << ", " << double(1 / smallest_range)
+        << "]: the velocity would overflow or underflow; rescale the covariates";
+    return Rejection{why.str()};
+  }
   problem.t.resize(n);
   problem.w.assign(n, Scalar(1));
   for (std::size_t i = 0; i < n; ++i) {
@@ -151,6 +181,24 @@ std::optional<Rejection> make_problem(
         "identifiable (mu_min = 0)"};
   }
   return std::nullopt;
+}
+
+// The weights divided by the largest (empty stays empty, as does a list
+// with no positive weight): the estimators depend only on the weights'
+// ratios, and sums of weights of 1e308, or products of subnormal weights
+// such as 1e-320, would overflow or lose every digit. For weights that
+// make_problem accepted; the statistics above fit() call it once, at
+// their entry.
+template <class Scalar>
+std::vector<Scalar> normalised_weights(const std::vector<Scalar>& weights) {
+  std::vector<Scalar> normalised(weights);
+  Scalar largest = 0;
+  for (const Scalar w : weights)
+    largest = std::max(largest, w);
+  if (!(largest > 0)) return normalised;
+  for (Scalar& w : normalised)
+    w /= largest;
+  return normalised;
 }
 
 // Every observation finite and in the group (to `tolerance`); the first

@@ -346,14 +346,24 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
     const std::function<void(std::size_t, std::size_t)>& progress = {}) {
   using Scalar = typename G::Scalar;
   BandwidthSelection<Scalar> selection;
+  if (grid.empty()) {
+    selection.message =
+        "the bandwidth grid is empty (bandwidth_grid gives none for fewer than two distinct "
+        "covariates, a covariate that is not finite or a range that overflows)";
+    return selection;
+  }
+  for (std::size_t j = 0; j < grid.size(); ++j) {
+    using std::isfinite;
+    if (!(grid[j] > 0) || !isfinite(grid[j])) {
+      selection.message =
+          "bandwidth grid value " + std::to_string(j) + " is not a positive finite number";
+      return selection;
+    }
+  }
   selection.grid = grid;
   std::sort(selection.grid.begin(), selection.grid.end());
   const std::size_t k = selection.grid.size();
   const std::size_t n = observations.size();
-  if (k == 0) {
-    selection.message = "the bandwidth grid is empty";
-    return selection;
-  }
   options.standard_errors = false;
   using Scatter = Eigen::Matrix<Scalar, G::dof, G::dof>;
   // Computed once the first held-out pass has checked the input.
@@ -475,27 +485,40 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
 }
 
 // `count` bandwidths, geometrically spaced from `smallest_spacings` median
-// sample spacings up to the covariates' whole range. Empty when the
-// covariates have fewer than two distinct values.
+// sample spacings up to the covariates' whole range. Empty (no grid, and
+// select_bandwidth then says so) when there is none to give: fewer than two
+// distinct covariates, a covariate that is not finite, a range that
+// overflows a double, `count` outside [2, kMaxGridSize], or
+// `smallest_spacings` not a positive finite number. Every value returned
+// is positive and finite.
+inline constexpr int kMaxGridSize = 10000;
+
 template <class Covariates>
 std::vector<double> bandwidth_grid(const Covariates& covariates, int count = 20,
                                    double smallest_spacings = 2) {
+  if (count < 2 || count > kMaxGridSize) return {};
+  if (!(smallest_spacings > 0) || !std::isfinite(smallest_spacings)) return {};
   std::vector<double> t(covariates.begin(), covariates.end());
+  for (const double covariate : t) {
+    if (!std::isfinite(covariate)) return {};
+  }
   std::sort(t.begin(), t.end());
   std::vector<double> spacings;
   for (std::size_t i = 1; i < t.size(); ++i) {
     if (t[i] > t[i - 1]) spacings.push_back(t[i] - t[i - 1]);
   }
-  if (spacings.empty() || count < 2) return {};
+  if (spacings.empty()) return {};
   const auto middle = spacings.begin() + static_cast<std::ptrdiff_t>(spacings.size() / 2);
   std::nth_element(spacings.begin(), middle, spacings.end());
   const double low = smallest_spacings * *middle;
   const double high = t.back() - t.front();
+  if (!std::isfinite(high) || !std::isfinite(low) || !(low > 0)) return {};
   if (!(high > low)) return {high};
   std::vector<double> grid(static_cast<std::size_t>(count));
-  const double ratio = std::log(high / low) / (count - 1);
+  const double ratio = (std::log(high) - std::log(low)) / (count - 1);  // high / low may overflow
   for (int k = 0; k < count; ++k)
     grid[static_cast<std::size_t>(k)] = low * std::exp(ratio * k);
+  grid.back() = high;  // exp(log(high / low)) may round past the range
   return grid;
 }
 

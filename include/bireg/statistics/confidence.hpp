@@ -38,6 +38,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Core>
@@ -78,35 +79,63 @@ EndpointMap<G> pose_map(const typename G::Tangent& x, typename G::Scalar s) {
   return map;
 }
 
+// Outside their domain (a covariate that is not finite, or so far from the
+// data that the covariance overflows) the covariances below are
+// unbounded: +infinity on the diagonal, 0 off it, never NaN. Their
+// standard errors and half-widths are then +infinity.
+template <class Matrix>
+Matrix unbounded_covariance() {
+  Matrix c = Matrix::Zero();
+  c.diagonal().setConstant(std::numeric_limits<typename Matrix::Scalar>::infinity());
+  return c;
+}
+
+template <class Matrix>
+Matrix bounded_or_unbounded(const Matrix& c) {
+  return c.allFinite() ? c : unbounded_covariance<Matrix>();
+}
+
 // Covariance of the body velocity X / (t_max - t_min), per covariate unit
 // squared.
 template <class G>
 typename G::AdMatrix velocity_covariance(const FitCovariance<G>& c) {
   const EndpointMap<G> spread = displacement_map<G>(c.geodesic.displacement()) * c.factor;
   const typename G::Scalar range = c.geodesic.t_max() - c.geodesic.t_min();
-  return spread * spread.transpose() / (range * range);
+  return bounded_or_unbounded<typename G::AdMatrix>(spread * spread.transpose() / (range * range));
 }
 
 // Covariance of the fitted pose at covariate t (user units), as the
 // left-trivialised perturbation eps with gamma^(t) = gamma(t) exp(eps).
 template <class G>
 typename G::AdMatrix pose_covariance(const FitCovariance<G>& c, typename G::Scalar t) {
-  const EndpointMap<G> spread =
-      pose_map<G>(c.geodesic.displacement(), c.geodesic.normalized(t)) * c.factor;
-  return spread * spread.transpose();
+  using std::isfinite;
+  const typename G::Scalar s = c.geodesic.normalized(t);
+  if (!isfinite(s)) return unbounded_covariance<typename G::AdMatrix>();
+  const EndpointMap<G> spread = pose_map<G>(c.geodesic.displacement(), s) * c.factor;
+  return bounded_or_unbounded<typename G::AdMatrix>(spread * spread.transpose());
 }
 
 // Covariance of the prediction error of a new observation at t.
 template <class G>
 typename G::AdMatrix prediction_covariance(const FitCovariance<G>& c, typename G::Scalar t) {
-  return pose_covariance(c, t) + c.residual;
+  return bounded_or_unbounded<typename G::AdMatrix>(pose_covariance(c, t) + c.residual);
 }
 
-// Square roots of the diagonal.
+// Square roots of the diagonal; +infinity where a variance is NaN or
+// +infinity (undefined or unbounded), 0 where it is negative (rounding).
 template <class Matrix>
 Eigen::Matrix<typename Matrix::Scalar, Matrix::RowsAtCompileTime, 1> standard_errors(
     const Matrix& c) {
-  return c.diagonal().cwiseMax(typename Matrix::Scalar(0)).cwiseSqrt();
+  using Scalar = typename Matrix::Scalar;
+  using std::isnan;
+  using std::sqrt;
+  Eigen::Matrix<Scalar, Matrix::RowsAtCompileTime, 1> errors(c.rows());
+  for (Eigen::Index k = 0; k < c.rows(); ++k) {
+    const Scalar variance = c(k, k);
+    errors[k] = isnan(variance) ? std::numeric_limits<Scalar>::infinity()
+                                : sqrt(variance > 0 ? variance : Scalar(0));
+  }
+  return errors;
 }
 
 // Rank of a covariance on its numerical range (kRangeTolerance).
@@ -115,10 +144,12 @@ int covariance_rank(const Matrix& c) {
   return ScatterRange<typename Matrix::Scalar, Matrix::RowsAtCompileTime>(c).rank();
 }
 
-// v^T C^+ v, C^+ the pseudo-inverse on C's numerical range.
+// v^T C^+ v, C^+ the pseudo-inverse on C's numerical range; +infinity
+// when v or C has an entry that is not finite (outside the domain).
 template <class Matrix, class Vector>
 typename Matrix::Scalar mahalanobis_squared(const Matrix& c, const Vector& v) {
   using Scalar = typename Matrix::Scalar;
+  if (!c.allFinite() || !v.allFinite()) return std::numeric_limits<Scalar>::infinity();
   const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
   const auto& values = solver.eigenvalues();
   const Scalar largest = values[values.size() - 1];
@@ -190,12 +221,26 @@ std::optional<double> prediction_quantile(const FitCovariance<G>& c, double leve
 }
 
 // Half-widths of a confidence ellipsoid with covariance c and squared
-// radius q along each coordinate (its projections: simultaneous intervals).
+// radius q along each coordinate (its projections: simultaneous intervals);
+// +infinity for a q that is negative or NaN (no quantile: unbounded) and
+// wherever the radius or the variance is unbounded.
 template <class Matrix>
 Eigen::Matrix<typename Matrix::Scalar, Matrix::RowsAtCompileTime, 1> half_widths(
     const Matrix& c, typename Matrix::Scalar q) {
+  using Scalar = typename Matrix::Scalar;
   using std::sqrt;
-  return sqrt(q) * standard_errors(c);
+  if (!(q >= 0)) {
+    return Eigen::Matrix<Scalar, Matrix::RowsAtCompileTime, 1>::Constant(
+        c.rows(), std::numeric_limits<Scalar>::infinity());
+  }
+  constexpr Scalar kUnbounded = std::numeric_limits<Scalar>::infinity();
+  const auto errors = standard_errors(c);
+  Eigen::Matrix<Scalar, Matrix::RowsAtCompileTime, 1> widths(c.rows());
+  for (Eigen::Index k = 0; k < c.rows(); ++k) {
+    // An unbounded radius or variance is unbounded, even against a zero.
+    widths[k] = (q == kUnbounded || errors[k] == kUnbounded) ? kUnbounded : sqrt(q) * errors[k];
+  }
+  return widths;
 }
 
 }  // namespace bireg

@@ -19,6 +19,7 @@
 // (inversion maps r_i by Ad_{f_i}, a different matrix per observation).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -46,13 +47,28 @@ template <class Scalar, int D>
 ExplainedVariance<Scalar> explained_variance(
     const std::vector<Eigen::Matrix<Scalar, D, 1>>& residuals,
     const std::vector<Eigen::Matrix<Scalar, D, 1>>& about_mean,
-    const std::vector<Scalar>& weights = {}) {
+    const std::vector<Scalar>& given_weights = {}) {
+  using std::isfinite;
   ExplainedVariance<Scalar> e;
   if (residuals.size() != about_mean.size() || residuals.empty() ||
-      (!weights.empty() && weights.size() != residuals.size())) {
+      (!given_weights.empty() && given_weights.size() != residuals.size())) {
     e.message = "residuals, residuals about the mean and weights differ in length";
     return e;
   }
+  for (std::size_t i = 0; i < given_weights.size(); ++i) {
+    if (!(given_weights[i] >= 0) || !isfinite(given_weights[i])) {
+      e.message = "weight " + std::to_string(i) + " is negative or not finite";
+      return e;
+    }
+  }
+  for (std::size_t i = 0; i < residuals.size(); ++i) {
+    if (!residuals[i].allFinite() || !about_mean[i].allFinite()) {
+      e.message = "residual " + std::to_string(i) + " is not finite";
+      return e;
+    }
+  }
+  // Divided by the largest: the sums neither overflow nor underflow.
+  const std::vector<Scalar> weights = normalised_weights(given_weights);
   const Eigen::Matrix<Scalar, D, D> s_res = scatter_matrix(residuals, weights);
   const Eigen::Matrix<Scalar, D, D> s_tot = scatter_matrix(about_mean, weights);
   if (!(s_tot.trace() > 0)) {

@@ -507,6 +507,22 @@ class LocalGeodesicRegression {
     if (estimate.ok() && windows.wide.covariates.size() > windows.narrow.covariates.size()) {
       widen(windows.wide, estimate);
     }
+    refuse_unrepresentable(estimate);
+  }
+
+  // Never a number where the computation failed: an estimate whose pose or
+  // velocity is not finite (a query and bandwidth ~1e200 on SO(3), ~1e8 on
+  // SL(3), where the local geodesic's value overflows) is a failure, and
+  // standard errors that overflow are undefined (0, not infinity or NaN).
+  static void refuse_unrepresentable(Estimate& estimate) {
+    if (estimate.velocity_error_defined && !estimate.velocity_error.allFinite()) {
+      estimate.velocity_error_defined = false;
+      estimate.velocity_error.setZero();
+    }
+    if (!estimate.ok() || (estimate.pose.allFinite() && estimate.velocity.allFinite())) return;
+    estimate.status = Status::diverged;
+    estimate.message = "the estimate at " + std::to_string(double(estimate.covariate)) +
+                       " is not representable: its pose or velocity overflows";
   }
 
   // Options::wide_windows: the wide fit from the narrow estimate's

@@ -135,7 +135,6 @@ MeanResult<G> mean(const Observations& observations,
     return result;
   }
   std::size_t heaviest = 0;
-  Scalar weight_sum = 0;
   for (std::size_t i = 0; i < weights.size(); ++i) {
     using std::isfinite;
     if (!(weights[i] >= 0) || !isfinite(weights[i])) {
@@ -144,10 +143,8 @@ MeanResult<G> mean(const Observations& observations,
       return result;
     }
     if (weights[i] > weights[heaviest]) heaviest = i;
-    weight_sum += weights[i];
   }
-  if (weights.empty()) weight_sum = static_cast<Scalar>(n);
-  if (!(weight_sum > 0)) {
+  if (!weights.empty() && !(weights[heaviest] > 0)) {
     result.message = "all weights are zero";
     return result;
   }
@@ -156,11 +153,18 @@ MeanResult<G> mean(const Observations& observations,
     result.bad_index = rejection->index;
     return result;
   }
-  // Weights divided by their sum: F is then an average, and its size
-  // comparable across data sets (scaling all weights changes nothing).
-  std::vector<Scalar> w(n, Scalar(1) / weight_sum);
+  // Weights divided by the largest, then by their sum: F is then an
+  // average, and its size comparable across data sets (scaling all weights
+  // changes nothing). Dividing by the largest first keeps the sum finite
+  // for weights of 1e308 and exact for subnormal weights such as 1e-320.
+  std::vector<Scalar> w(n, Scalar(1));
   for (std::size_t i = 0; i < weights.size(); ++i)
-    w[i] = weights[i] / weight_sum;
+    w[i] = weights[i] / weights[heaviest];
+  Scalar weight_sum = 0;
+  for (const Scalar wi : w)
+    weight_sum += wi;
+  for (Scalar& wi : w)
+    wi /= weight_sum;
 
   std::vector<Tangent> y(n), trial_y(n);
   Tangent force;

@@ -112,6 +112,7 @@
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -320,6 +321,22 @@ std::optional<Rejection> check_covariates(std::size_t observations, const Times&
                            "covariates would overflow",
                        index};
     }
+  }
+  // A range the fits refuse (make_problem: the velocity would overflow or
+  // underflow) is refused here, before any candidate, so that no model is
+  // recommended for lack of a rival.
+  double smallest = times[0], largest = times[0];
+  for (std::size_t i = 1; i < times.size(); ++i) {
+    smallest = std::min<double>(smallest, times[i]);
+    largest = std::max<double>(largest, times[i]);
+  }
+  const double range = largest - smallest;
+  const double limit = covariate_range_limit<double>();
+  if (range > 0 && (range < limit || range > 1 / limit)) {
+    std::ostringstream why;
+    why << "the covariates' range " << range << " lies outside [" << limit << ", " << 1 / limit
+        << "]: the velocity would overflow or underflow; rescale the covariates";
+    return Rejection{why.str()};
   }
   return std::nullopt;
 }

@@ -171,7 +171,7 @@ class RobustGeodesicRegression {
   // multiply the robust weights.
   template <class Observations, class Covariates>
   Result fit(const Observations& observations, const Covariates& covariates,
-             const std::vector<Scalar>& weights = {}) const {
+             const std::vector<Scalar>& given_weights = {}) const {
     using std::isfinite;
     Result result;
     result.loss = options_.loss;
@@ -198,7 +198,10 @@ class RobustGeodesicRegression {
     }
 
     const GeodesicRegression<G> regression(regression_);
-    result.fit = regression.fit(observations, covariates, weights);
+    result.fit = regression.fit(observations, covariates, given_weights);
+    // Accepted by the fit (or refused below); divided by the largest, so
+    // that the scatter's sums neither overflow nor underflow.
+    const std::vector<Scalar> weights = normalised_weights(given_weights);
     result.fit_iterations = result.fit.iterations;
     // A plain fit that failed but returned endpoints (no_descent,
     // max_iterations, ...: gross outliers can take the data outside the

@@ -233,7 +233,7 @@ class LambdaDecision {
 template <class G, class Observations, class Covariates>
 TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
                               const Observations& observations, const Covariates& covariates,
-                              const std::vector<typename G::Scalar>& weights = {},
+                              const std::vector<typename G::Scalar>& given_weights = {},
                               const TrendTestOptions& options = {}) {
   using Scalar = typename G::Scalar;
   using Wide = CovariateScalar<Scalar>;
@@ -250,13 +250,16 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
     result.message = "threads must be at least 1, got " + std::to_string(options.threads);
     return result;
   }
-  result.fit = regression.fit(observations, covariates, weights);
+  result.fit = regression.fit(observations, covariates, given_weights);
   if (!result.fit.ok()) {
     result.status = result.fit.status;
     result.message = "the fit did not succeed (" + std::string(to_string(result.fit.status)) +
                      (result.fit.message.empty() ? "" : ": " + result.fit.message) + ")";
     return result;
   }
+  // Accepted by the fit; from here on divided by the largest, so that the
+  // scatter sums neither overflow (weights of 1e308) nor underflow (1e-320).
+  const std::vector<Scalar> weights = normalised_weights(given_weights);
   result.mean = bireg::mean<G>(observations, weights);
   if (!result.mean.ok()) {
     result.status = result.mean.status;
