@@ -17,7 +17,7 @@
 
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/testing/random.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/model_selection.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
 
 namespace {
 

@@ -13,10 +13,10 @@
 
 #include "bireg/groups/se3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/permutation.hpp"
-#include "bireg/statistics/trend_test.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/permutation.hpp"
+#include "bireg/statistics/inference/trend_test.hpp"
 
 namespace {
 

@@ -22,8 +22,8 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/confidence.hpp"
-#include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
 #include "svg_plot.hpp"
 
 #ifndef BIREG_DEMO_DATA_DIR

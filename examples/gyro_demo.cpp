@@ -38,7 +38,7 @@
 #include <vector>
 
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/testing/fast_motion.hpp"
 #include "svg_plot.hpp"
 

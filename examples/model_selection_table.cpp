@@ -28,7 +28,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/formats.hpp"
 #include "bireg/io/line_reader.hpp"
-#include "bireg/statistics/model_selection.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/testing/random.hpp"
 
 namespace {

@@ -14,7 +14,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 

@@ -1,5 +1,5 @@
 // Local regression on motion that is fast for its sampling rate
-// (statistics/local_regression.hpp; issue "Velocity on fast real motion"):
+// (statistics/smoothing/local_regression.hpp; issue "Velocity on fast real motion"):
 // windows cut where they would turn too far, a bandwidth choice that
 // counts its failures instead of dropping a bandwidth for one, a velocity
 // whose bandwidth is chosen for the velocity, and ends without the local
@@ -25,7 +25,7 @@
 
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/testing/fast_motion.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -74,7 +74,7 @@ Velocities auto_velocity(const RotationTrack& track) {
 // Shrinking the correction by its significance closed these (1.04-1.12x)
 // but made the velocity's cross-validation curve ragged on slow data (a
 // constant spin's velocity 3x worse), so it is not in. Every other "1.15x the chart line" bound is
-// met since the wide windows (statistics/local_wide.hpp) and the
+// met since the wide windows (statistics/smoothing/local_wide.hpp) and the
 // five-point target of the velocity's cross-validation.
 struct Gap {
   const char* name;

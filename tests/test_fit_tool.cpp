@@ -26,11 +26,11 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/confidence.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/explained_variance.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/trend_test.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/explained_variance.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/trend_test.hpp"
 #include "bireg/version.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -1171,7 +1171,7 @@ TEST_CASE("bireg_fit --loss names the planted outlier's line and fits closer to 
 // reweighting did not settle exits 3; the top-level "status" must then be
 // the robust one (the one that decided the exit code), not the last
 // weighted fit's "converged", and stderr must say why the exit is 3. Two
-// robust failures the library documents (statistics/robust.hpp): fewer
+// robust failures the library documents (statistics/robust/regression.hpp): fewer
 // observations than the robust fit in SE(3) needs (dof + 2 = 8), and planar
 // motion fitted in SE(3), whose residuals have no z, rot_x or rot_y
 // component, so their scatter is singular.

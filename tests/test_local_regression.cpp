@@ -1,4 +1,4 @@
-// Local geodesic regression (statistics/local_regression.hpp): textbook
+// Local geodesic regression (statistics/smoothing/local_regression.hpp): textbook
 // local-linear regression on R^n, exact recovery of noise-free geodesics,
 // the global fit as the bandwidth grows, left and right equivariance,
 // independence of the queries' order, real IMU data turning through more
@@ -16,7 +16,7 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 

@@ -1,4 +1,4 @@
-// Wide windows for fast rotation (statistics/local_wide.hpp): the wide fit
+// Wide windows for fast rotation (statistics/smoothing/local_wide.hpp): the wide fit
 // is fit() in other coordinates where both apply, recovers a geodesic that
 // turns by more than pi, keeps left and right equivariance; the windows
 // that feed it (local_window.hpp: path_radius, the turn cut looking past
@@ -14,8 +14,8 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/testing/fast_motion.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"

@@ -1,4 +1,4 @@
-// Motion-model selection (statistics/model_selection.hpp): recovery of the
+// Motion-model selection (statistics/selection/model_selection.hpp): recovery of the
 // generating model on simulated scenes, invariance, nesting, degenerate input.
 #include <algorithm>
 #include <array>
@@ -12,7 +12,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/model_selection.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/testing/random.hpp"
 #include "catch.hpp"
 

@@ -1,4 +1,4 @@
-// The robust fit (bireg/statistics/robust.hpp): tuning constants, resistance
+// The robust fit (bireg/statistics/robust/regression.hpp): tuning constants, resistance
 // to gross outliers on SO(3) and SE(3), the pi/2 outlier of test_stability,
 // left and right equivariance (and how a Euclidean weighting breaks it),
 // efficiency without outliers, and failures as a status, never NaN.
@@ -18,7 +18,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/robust.hpp"
+#include "bireg/statistics/robust/regression.hpp"
 #include "bireg/testing/random.hpp"
 #include "catch.hpp"
 

@@ -12,9 +12,9 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/confidence.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/trend_test.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/trend_test.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 

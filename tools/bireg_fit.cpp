@@ -26,7 +26,7 @@
 // The long spellings of the library's option names are accepted as well:
 // --series-order, --step-size, --tolerance, --max-iterations.
 //
-// --loss fits robustly (bireg/statistics/robust.hpp: reweighting on the
+// --loss fits robustly (bireg/statistics/robust/regression.hpp: reweighting on the
 // residuals' Mahalanobis distances, C defaulting to 95% Gaussian
 // efficiency); the JSON then has a "robust" object with the flagged
 // outliers' input line numbers and the last weighted fit's "fit_status",
@@ -41,7 +41,7 @@
 // both flavours ("homoscedastic": one residual covariance for all
 // observations; "heteroscedasticity_robust": the HC2 sandwich), their
 // degrees of freedom, and the explained variances against the bi-invariant
-// mean (R^2 and Wilks' form); bireg/statistics/covariance.hpp,
+// mean (R^2 and Wilks' form); bireg/statistics/inference/covariance.hpp,
 // confidence.hpp and explained_variance.hpp. --permutations B (B >= 1)
 // [--seed S] (default 0) adds a "trend_test" object: Wilks' Lambda and the
 // permutation p-value of "f does not depend on t" (trend_test.hpp).

@@ -1,5 +1,5 @@
 // bireg_smooth: pose and body velocity along a whole trajectory by
-// kernel-weighted local geodesic regression (bireg/statistics/local_regression.hpp).
+// kernel-weighted local geodesic regression (bireg/statistics/smoothing/local_regression.hpp).
 //
 //   bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]
 //                [--times FILE] [--project]
@@ -74,7 +74,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/local_regression.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
@@ -97,7 +97,7 @@ constexpr const char* kUsage =
 
 constexpr const char* kHelp =
     "Pose and body velocity along a trajectory by kernel-weighted local geodesic\n"
-    "regression (bireg/statistics/local_regression.hpp).\n"
+    "regression (bireg/statistics/smoothing/local_regression.hpp).\n"
     "\n"
     "  --group G          SO2, SO3, SE2 or SE3 (required)\n"
     "  --format F         input format: matrix, tum, euroc or kitti (default: detected)\n"

@@ -1,5 +1,5 @@
 // bireg_fit --group auto: which pose-motion model the data need
-// (bireg/statistics/model_selection.hpp), and that model's fit.
+// (bireg/statistics/selection/model_selection.hpp), and that model's fit.
 //
 // The input is read in one pass as Sim(3) (TUM, EuRoC, KITTI or the 4x4
 // matrix format; the pose formats give similarities of scale 1). If every

@@ -14,7 +14,7 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/regression/solver.hpp"
 #include "bireg/regression/status.hpp"
-#include "bireg/statistics/robust_loss.hpp"
+#include "bireg/statistics/robust/loss.hpp"
 #include "cli_common.hpp"
 
 namespace bireg_cli {

@@ -25,11 +25,11 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/confidence.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/explained_variance.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/trend_test.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/explained_variance.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/trend_test.hpp"
 
 namespace bireg_fit_report {
 

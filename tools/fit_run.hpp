@@ -15,7 +15,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/robust.hpp"
+#include "bireg/statistics/robust/regression.hpp"
 #include "cli_common.hpp"
 #include "fit_command.hpp"
 #include "fit_report.hpp"

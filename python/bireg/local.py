@@ -1,6 +1,6 @@
 """Local (kernel-weighted) geodesic regression: the pose and velocity along
 a trajectory, as ``bireg_smooth`` computes them
-(bireg::LocalGeodesicRegression, include/bireg/statistics/local_geodesic.hpp).
+(bireg::LocalGeodesicRegression, include/bireg/statistics/smoothing/local_geodesic.hpp).
 """
 
 import warnings

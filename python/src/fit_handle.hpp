@@ -13,7 +13,7 @@
 #include "common.hpp"
 
 #include "bireg/regression.hpp"
-#include "bireg/statistics/robust.hpp"
+#include "bireg/statistics/robust/regression.hpp"
 
 namespace bireg_python {
 

@@ -7,8 +7,8 @@
 
 #include <bireg/groups/se3.hpp>
 #include <bireg/regression.hpp>
-#include <bireg/statistics/covariance.hpp>
-#include <bireg/statistics/mean.hpp>
+#include <bireg/statistics/inference/covariance.hpp>
+#include <bireg/statistics/inference/mean.hpp>
 
 #ifndef BIREG_PRECOMPILED
 #error "bireg::bireg_precompiled must define BIREG_PRECOMPILED for its consumers"

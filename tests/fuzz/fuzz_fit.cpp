@@ -51,10 +51,10 @@
 #include "bireg/io/line_reader.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/model_selection.hpp"
-#include "bireg/statistics/trend_test.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
+#include "bireg/statistics/inference/trend_test.hpp"
 
 namespace {
 

@@ -51,9 +51,9 @@ foreach(tree good upward unknown testing_io includes_side)
   write(${tree} geodesic.hpp "#include \"bireg/concept.hpp\"")
   write(${tree} regression/step.hpp "#include \"bireg/geodesic.hpp\"")
   write(${tree} regression.hpp "#include \"bireg/regression/step.hpp\"")
-  write(${tree} statistics/mean.hpp "  #  include \"bireg/regression.hpp\"")
+  write(${tree} statistics/inference/mean.hpp "  #  include \"bireg/regression.hpp\"")
   write(${tree} io/f.hpp "#include \"bireg/groups/g.hpp\"")
-  write(${tree} testing/laws.hpp "#include \"bireg/statistics/mean.hpp\""
+  write(${tree} testing/laws.hpp "#include \"bireg/statistics/inference/mean.hpp\""
     "#include \"bireg/testing/more.hpp\"")
   write(${tree} testing/more.hpp "#include \"bireg/concept.hpp\"")
   write(${tree} bireg.hpp "#include \"bireg/io/f.hpp\"" "#include \"bireg/testing/laws.hpp\"")

@@ -19,7 +19,7 @@
 //       the algebra of analytic functions of ad_x in five numbers
 //       (math/ad_algebra.hpp; SO(3) and SE(3)): the covariance sums its
 //       per-observation Jacobians there. fallback: d x d matrices per
-//       observation (statistics/covariance.hpp).
+//       observation (statistics/inference/covariance.hpp).
 //   struct ClosedFormPsi                             psi_s(ad_x) r in closed form
 //       (see math/psi_closed_form.hpp and SO3::ClosedFormPsi for the
 //       interface; with kTerms, coefficients and combine where it is a sum
@@ -33,7 +33,7 @@
 //       turn between two observations, turn_angle(f_a^{-1} f_b), is left
 //       and right invariant; the principal log is defined while it is below
 //       pi. Local regression caps its windows in it
-//       (statistics/local_window.hpp). fallback: none (has_turn_angle_v
+//       (statistics/smoothing/local_window.hpp). fallback: none (has_turn_angle_v
 //       is false and windows are not capped); SO(2), SE(2), SO(3), SE(3)
 //       and Sim(3) provide it.
 //

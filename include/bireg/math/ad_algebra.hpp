@@ -16,7 +16,7 @@
 // off-diagonal block the derivative of F(W) along P, which moves theta at
 // the rate kappa / theta: p = (kappa / theta) db/dtheta, q = (kappa / theta)
 // dc/dtheta. Products and inverses of such functions are scalar arithmetic
-// (below). The covariance (statistics/covariance.hpp) sums J_r(-uX)^{-1}
+// (below). The covariance (statistics/inference/covariance.hpp) sums J_r(-uX)^{-1}
 // J_r(tX) and Psi_i S Psi_i^T over the observations this way, with no d x d
 // product per observation.
 //

@@ -67,7 +67,7 @@ CovariateScalar<Scalar> covariate_range_limit() {
 }
 
 // The same for the velocity's covariance, C / range^2: its square root,
-// 1e-146 in double, 3e-16 in float (statistics/covariance.hpp refuses a
+// 1e-146 in double, 3e-16 in float (statistics/inference/covariance.hpp refuses a
 // covariance outside it as undefined; the fit itself stands).
 template <class Scalar>
 CovariateScalar<Scalar> covariance_range_limit() {

@@ -34,8 +34,8 @@
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/status.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/permutation.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/permutation.hpp"
 
 namespace bireg {
 

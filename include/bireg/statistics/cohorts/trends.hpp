@@ -37,9 +37,9 @@
 #include "bireg/regression.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
-#include "bireg/statistics/distributions.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/inference/distributions.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/scatter.hpp"
 
 namespace bireg {
 

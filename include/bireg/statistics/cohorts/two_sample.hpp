@@ -46,9 +46,9 @@
 #include "bireg/concept.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/status.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/permutation.hpp"
-#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/permutation.hpp"
+#include "bireg/statistics/inference/scatter.hpp"
 
 namespace bireg {
 

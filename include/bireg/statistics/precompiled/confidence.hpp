@@ -1,5 +1,5 @@
 // Explicit instantiation declarations of the covariances and quantiles derived from a FitCovariance
-// from bireg/statistics/confidence.hpp, for the groups and scalars that the compiled part holds
+// from bireg/statistics/inference/confidence.hpp, for the groups and scalars that the compiled part holds
 // (bireg::bireg_precompiled; what it covers and why, in bireg/regression/precompiled.hpp). Included
 // at the end of that header when BIREG_PRECOMPILED is defined; it needs nothing the header has not
 // declared, so that the headers may include one another in any order.
@@ -11,7 +11,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/confidence.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
 
 namespace bireg {
 

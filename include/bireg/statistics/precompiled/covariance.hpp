@@ -1,5 +1,5 @@
 // Explicit instantiation declarations of covariance() and covariance_of() from
-// bireg/statistics/covariance.hpp, for the groups and scalars that the compiled
+// bireg/statistics/inference/covariance.hpp, for the groups and scalars that the compiled
 // part holds (bireg::bireg_precompiled; what it covers and why, in
 // bireg/regression/precompiled.hpp). Included at the end of that header when
 // BIREG_PRECOMPILED is defined; it needs nothing the header has not
@@ -12,7 +12,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/covariance.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
 
 namespace bireg {
 

@@ -1,5 +1,5 @@
 // Explicit instantiation declarations of mean() from
-// bireg/statistics/mean.hpp, for the groups and scalars that the compiled
+// bireg/statistics/inference/mean.hpp, for the groups and scalars that the compiled
 // part holds (bireg::bireg_precompiled; what it covers and why, in
 // bireg/regression/precompiled.hpp). Included at the end of that header when
 // BIREG_PRECOMPILED is defined; it needs nothing the header has not
@@ -12,7 +12,7 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
-#include "bireg/statistics/mean.hpp"
+#include "bireg/statistics/inference/mean.hpp"
 
 namespace bireg {
 

@@ -1,4 +1,4 @@
-// bireg: the kernels of local regression (statistics/local_geodesic.hpp)
+// bireg: the kernels of local regression (statistics/smoothing/local_geodesic.hpp)
 // and their supports.
 #pragma once
 

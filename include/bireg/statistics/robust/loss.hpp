@@ -38,7 +38,7 @@
 #include <cmath>
 #include <string>
 
-#include "bireg/statistics/distributions.hpp"
+#include "bireg/statistics/inference/distributions.hpp"
 
 namespace bireg {
 

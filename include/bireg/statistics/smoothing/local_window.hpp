@@ -1,4 +1,4 @@
-// bireg: the window of a local regression query (statistics/local_geodesic.hpp):
+// bireg: the window of a local regression query (statistics/smoothing/local_geodesic.hpp):
 // which observations it holds, how far it may reach on fast rotation, and
 // the quadratic correction of its velocity (DESIGN.md section 5).
 #pragma once
@@ -13,7 +13,7 @@
 
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/capabilities.hpp"
-#include "bireg/statistics/kernel.hpp"
+#include "bireg/statistics/smoothing/kernel.hpp"
 
 namespace bireg {
 
@@ -34,7 +34,7 @@ struct LocalWindow {
 // What decides a window: the kernel, its bandwidth, and the most the
 // window may turn (LocalRegressionOptions). A `wide` window may turn by
 // max_turn on each side of the query (path_radius) instead of max_turn in
-// all (turn_radius), for the wide fit (statistics/local_wide.hpp).
+// all (turn_radius), for the wide fit (statistics/smoothing/local_wide.hpp).
 template <class Scalar>
 struct WindowShape {
   Kernel kernel = Kernel::gaussian;

@@ -1,5 +1,5 @@
 // bireg: the automatic bandwidth of local regression
-// (statistics/local_geodesic.hpp) by cross-validation, one choice for the
+// (statistics/smoothing/local_geodesic.hpp) by cross-validation, one choice for the
 // pose and one for the velocity (DESIGN.md section 5).
 #pragma once
 
@@ -16,7 +16,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
-#include "bireg/statistics/local_geodesic.hpp"
+#include "bireg/statistics/smoothing/local_geodesic.hpp"
 
 namespace bireg {
 

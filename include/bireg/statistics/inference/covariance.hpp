@@ -37,7 +37,7 @@
 // Degrees of freedom for the confidence regions. The homoscedastic flavour
 // estimates one d x d matrix S from nu degrees of freedom, and the
 // ellipsoids use Hotelling / Lawley-Hotelling quantiles with nu
-// (statistics/confidence.hpp). The robust flavour estimates the whole
+// (statistics/inference/confidence.hpp). The robust flavour estimates the whole
 // covariance of a p-dimensional quantity L delta from N rank-one terms
 // z_i z_i^T, z_i = L K^{-1} w_i Psi_i r_i / sqrt(v_i), far more variable
 // than S: with the homoscedastic quantiles its 95% ellipsoids covered 84%
@@ -151,7 +151,7 @@ struct FitCovariance {
   EndpointMatrix endpoints = EndpointMatrix::Zero();
   // F with endpoints = F F^T: a linear map L of the endpoints has
   // covariance (L F)(L F)^T, positive semi-definite to rounding however
-  // large L's entries (statistics/confidence.hpp forms them so).
+  // large L's entries (statistics/inference/confidence.hpp forms them so).
   EndpointMatrix factor = EndpointMatrix::Zero();
   // The exact K at the estimate (see above).
   EndpointMatrix jacobian = EndpointMatrix::Zero();

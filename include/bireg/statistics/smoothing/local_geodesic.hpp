@@ -1,6 +1,6 @@
 // bireg: kernel-weighted local geodesic regression (DESIGN.md section 5):
-// the estimator. statistics/bandwidth.hpp chooses its bandwidth;
-// statistics/local_regression.hpp includes both.
+// the estimator. statistics/smoothing/bandwidth.hpp chooses its bandwidth;
+// statistics/smoothing/local_regression.hpp includes both.
 //
 // At a query covariate tau the local estimate is the bi-invariant geodesic
 // regression (paper, Definition 2.1) of the observations with weights
@@ -40,7 +40,7 @@
 // by max_turn on each side, carried by (g0, X) so that the turn may pass
 // pi, and replaces the estimate when it converges.
 //
-// Options::robust makes every query a robust fit (statistics/robust.hpp).
+// Options::robust makes every query a robust fit (statistics/robust/regression.hpp).
 #pragma once
 
 #include <algorithm>
@@ -60,12 +60,12 @@
 #include "bireg/geodesic.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/regression/parallel.hpp"
-#include "bireg/statistics/confidence.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/kernel.hpp"
-#include "bireg/statistics/local_wide.hpp"
-#include "bireg/statistics/local_window.hpp"
-#include "bireg/statistics/robust.hpp"
+#include "bireg/statistics/inference/confidence.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/smoothing/kernel.hpp"
+#include "bireg/statistics/smoothing/local_wide.hpp"
+#include "bireg/statistics/smoothing/local_window.hpp"
+#include "bireg/statistics/robust/regression.hpp"
 
 namespace bireg {
 
@@ -75,10 +75,10 @@ struct LocalRegressionOptions {
   Scalar bandwidth = Scalar(1);  // h, in covariate units
   // Of every local fit; `interval` is set per query and must be empty here.
   RegressionOptions<Scalar> fit;
-  // Compute the velocity's standard errors (statistics/covariance.hpp with
+  // Compute the velocity's standard errors (statistics/inference/covariance.hpp with
   // the kernel weights, homoscedastic).
   bool standard_errors = true;
-  // When set, every query is a robust fit (statistics/robust.hpp) of its
+  // When set, every query is a robust fit (statistics/robust/regression.hpp) of its
   // window with the kernel weights as user weights, so an observation's
   // weight is K((t_i - tau) / h) times its robust weight. The robust fit
   // starts cold from the window's plain fit (its reweighting needs the
@@ -119,7 +119,7 @@ struct LocalRegressionOptions {
   // Where the turn cut shortened a window (fast rotation), refit the
   // window that may turn by max_turn on each side of the query (its path,
   // local_window.hpp's path_radius) instead of max_turn in all, carried by
-  // (g0, X) so that the whole turn may pass pi (statistics/local_wide.hpp:
+  // (g0, X) so that the whole turn may pass pi (statistics/smoothing/local_wide.hpp:
   // the same estimator in other coordinates), from the narrow window's
   // geodesic. Twice the turn is up to twice the samples in the velocity
   // when the motion is fast for its sampling rate. A wide fit that does

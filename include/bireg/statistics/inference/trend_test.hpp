@@ -4,9 +4,9 @@
 //
 // Statistic: Wilks' Lambda = det(S_res) / det(S_tot), S_res = sum w r r^T
 // about the fitted geodesic, S_tot = sum w y y^T about the bi-invariant
-// mean (statistics/mean.hpp). Lambda is in (0, 1]; small Lambda means the
+// mean (statistics/inference/mean.hpp). Lambda is in (0, 1]; small Lambda means the
 // geodesic explains much of the spread: a strong trend. It is left and
-// right invariant on every group (statistics/scatter.hpp), so the test
+// right invariant on every group (statistics/inference/scatter.hpp), so the test
 // inherits the estimator's equivariance (the paper's Theorem 2.4): the
 // statistic moves by rounding only, and the p-value, computed from the
 // same permutations, is identical. Where S_tot is singular the ratio is
@@ -26,7 +26,7 @@
 // not exchangeable, so there a small p says "not exchangeable", not
 // "trend".
 //
-// Permutation b depends only on (seed, b) (statistics/permutation.hpp) and
+// Permutation b depends only on (seed, b) (statistics/inference/permutation.hpp) and
 // each permuted fit's start depends on the permuted data only, so the
 // result is identical for any order or thread count. With
 // TrendTestOptions::threads > 1 blocks of permutations run on a pool
@@ -61,9 +61,9 @@
 
 #include "bireg/regression.hpp"
 #include "bireg/regression/parallel.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/permutation.hpp"
-#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/permutation.hpp"
+#include "bireg/statistics/inference/scatter.hpp"
 
 namespace bireg {
 

@@ -22,9 +22,9 @@
 // Hotelling's T^2(d, nu) exactly on R^n with Gaussian noise (velocity, one
 // pose, a prediction), and the two endpoints together (a d x d S shared by
 // a q = 2 dimensional design) follow the Lawley-Hotelling trace
-// (McKeon's approximation; statistics/distributions.hpp). Robust flavour:
+// (McKeon's approximation; statistics/inference/distributions.hpp). Robust flavour:
 // Hotelling's T^2 in the quantity's full dimension with the Satterthwaite
-// degrees of freedom of statistics/covariance.hpp; between the endpoints
+// degrees of freedom of statistics/inference/covariance.hpp; between the endpoints
 // the pose uses the smaller of the two endpoints' values (conservative).
 // On curved groups all of these are first-order (small-noise) statements;
 // the chi-square quantile (nu -> infinity) is available for comparison and
@@ -46,9 +46,9 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
-#include "bireg/statistics/covariance.hpp"
-#include "bireg/statistics/distributions.hpp"
-#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/inference/distributions.hpp"
+#include "bireg/statistics/inference/scatter.hpp"
 
 namespace bireg {
 

@@ -7,7 +7,7 @@
 //
 //   d_i^2 = r_i^T S^{-1} r_i,   r_i = log(gamma(t_i)^{-1} f_i)   (left-trivialised),
 //
-// rho a loss of statistics/robust_loss.hpp and S a robust scatter of the
+// rho a loss of statistics/robust/loss.hpp and S a robust scatter of the
 // residuals. Under left translation of the data r_i is unchanged; under
 // right translation by h it becomes Ad_{h^{-1}} r_i, and S (built below from
 // the residuals alone) becomes Ad_{h^{-1}} S Ad_{h^{-1}}^T, so d_i, the
@@ -73,7 +73,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/robust_loss.hpp"
+#include "bireg/statistics/robust/loss.hpp"
 
 namespace bireg {
 

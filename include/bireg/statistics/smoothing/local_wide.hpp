@@ -1,5 +1,5 @@
 // bireg: the local geodesic on a window that turns by more than pi
-// (statistics/local_geodesic.hpp, LocalRegressionOptions::wide_windows;
+// (statistics/smoothing/local_geodesic.hpp, LocalRegressionOptions::wide_windows;
 // DESIGN.md section 5, "Wide windows").
 //
 // Why. A local fit is the bi-invariant geodesic regression of its window
@@ -36,7 +36,7 @@
 // and is unchanged by left translation, so the step and the fit keep the
 // paper's Theorem 2.4 equivariance.
 //
-// Standard errors. The sandwich of statistics/covariance.hpp (homoscedastic
+// Standard errors. The sandwich of statistics/inference/covariance.hpp (homoscedastic
 // flavour) in the same coordinates: Cov(d0, d1) = K^{-1} M K^{-T},
 // M = sum_i w_i^2 Psi_i S Psi_i^T, Psi_i = [psi_{1-t_i}(-A); psi_{t_i}(A)],
 // S = sum_i w_i r_i r_i^T / nu, nu = W - tr(H^{-1} H_2); the velocity's
@@ -56,7 +56,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/groups/capabilities.hpp"
-#include "bireg/statistics/local_window.hpp"
+#include "bireg/statistics/smoothing/local_window.hpp"
 
 namespace bireg {
 

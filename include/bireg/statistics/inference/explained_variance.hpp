@@ -5,14 +5,14 @@
 //   generalised:  1 - Lambda,  Lambda = det(S_res) / det(S_tot)  (Wilks),
 //
 // r_i the fit's residuals, y_i = log(m^{-1} f_i) about the mean m
-// (statistics/mean.hpp), S_res = sum w r r^T, S_tot = sum w y y^T.
+// (statistics/inference/mean.hpp), S_res = sum w r r^T, S_tot = sum w y y^T.
 //
 // The Euclidean form is the ordinary R^2 on R^n. It is left invariant on
 // every group (left translation changes neither r_i nor y_i), but right
 // translation maps both by Ad_{h^{-1}}, which preserves |.| only on compact
 // groups (SO(n), with its bi-invariant metric): on SE(3) it also mixes the
 // units of rotation and translation. The generalised form is left and
-// right invariant on every group (statistics/scatter.hpp) and unit-free;
+// right invariant on every group (statistics/inference/scatter.hpp) and unit-free;
 // where S_tot is singular both determinants are taken on its numerical
 // range (pseudo-determinant), reported by `rank` and `pseudo_determinant`.
 // Both are invariant under inversion only to first order in the residuals
@@ -25,8 +25,8 @@
 #include <vector>
 
 #include "bireg/regression/result.hpp"
-#include "bireg/statistics/mean.hpp"
-#include "bireg/statistics/scatter.hpp"
+#include "bireg/statistics/inference/mean.hpp"
+#include "bireg/statistics/inference/scatter.hpp"
 
 namespace bireg {
 

@@ -1,0 +1,9 @@
+// bireg: model selection, both questions: which motion model a pose
+// sequence requires (selection/motion_models.hpp) and whether an element
+// moves along its covariate at all (selection/static_or_geodesic.hpp),
+// with the criterion they share (selection/criteria.hpp).
+#pragma once
+
+#include "bireg/statistics/selection/criteria.hpp"
+#include "bireg/statistics/selection/motion_models.hpp"
+#include "bireg/statistics/selection/static_or_geodesic.hpp"
