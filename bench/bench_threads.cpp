@@ -20,9 +20,9 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
-#include "bireg/statistics/smoothing/local_regression.hpp"
-#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/testing/random.hpp"
 
 namespace {

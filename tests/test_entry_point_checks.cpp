@@ -28,8 +28,8 @@
 #include "bireg/statistics/inference/confidence.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
 #include "bireg/statistics/inference/distributions.hpp"
-#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/statistics/robust/regression.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/testing/random.hpp"
 #include "catch.hpp"
 

@@ -15,9 +15,9 @@
 #include "bireg/statistics/inference/confidence.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
 #include "bireg/statistics/inference/explained_variance.hpp"
-#include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
+#include "bireg/statistics/smoothing/local_regression.hpp"
 
 namespace bireg_python {
 namespace statistics_detail {

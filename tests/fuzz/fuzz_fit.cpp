@@ -53,8 +53,8 @@
 #include "bireg/regression.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
 #include "bireg/statistics/inference/mean.hpp"
-#include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
+#include "bireg/statistics/selection/model_selection.hpp"
 
 namespace {
 

@@ -1,8 +1,8 @@
 // Explicit instantiation declarations of the covariances and quantiles derived from a FitCovariance
-// from bireg/statistics/inference/confidence.hpp, for the groups and scalars that the compiled part holds
-// (bireg::bireg_precompiled; what it covers and why, in bireg/regression/precompiled.hpp). Included
-// at the end of that header when BIREG_PRECOMPILED is defined; it needs nothing the header has not
-// declared, so that the headers may include one another in any order.
+// from bireg/statistics/inference/confidence.hpp, for the groups and scalars that the compiled part
+// holds (bireg::bireg_precompiled; what it covers and why, in bireg/regression/precompiled.hpp).
+// Included at the end of that header when BIREG_PRECOMPILED is defined; it needs nothing the header
+// has not declared, so that the headers may include one another in any order.
 #pragma once
 
 #include <optional>

@@ -62,10 +62,10 @@
 #include "bireg/regression/parallel.hpp"
 #include "bireg/statistics/inference/confidence.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
+#include "bireg/statistics/robust/regression.hpp"
 #include "bireg/statistics/smoothing/kernel.hpp"
 #include "bireg/statistics/smoothing/local_wide.hpp"
 #include "bireg/statistics/smoothing/local_window.hpp"
-#include "bireg/statistics/robust/regression.hpp"
 
 namespace bireg {
 
