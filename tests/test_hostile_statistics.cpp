@@ -14,8 +14,8 @@
 
 #include <Eigen/Core>
 
-#include "bireg/groups/matrix_group.hpp"
 #include "bireg/groups/se3.hpp"
+#include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/statistics/inference/confidence.hpp"
@@ -32,8 +32,8 @@
 namespace {
 
 using bireg::SE3d;
+using bireg::Sim3d;
 using bireg::SO3d;
-using SL3d = bireg::SL3<double>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // n noisy observations along exp(s x), s = i / (n - 1), for any group.
@@ -212,19 +212,25 @@ TEST_CASE(
   REQUIRE(std::abs(bireg::mahalanobis_squared(velocity, v) - v.dot(velocity.ldlt().solve(v))) <=
           1e-9 * v.dot(velocity.ldlt().solve(v)));
 
-  // SL(3): the pose's covariance overflows from t ~ 1e8 (exp of a large
-  // non-compact element); unbounded then, never NaN.
-  const auto g = noisy_line<SL3d>(20, 0.01, 3);
-  const auto sl3_fit = bireg::GeodesicRegression<SL3d>().fit(g, t);
-  REQUIRE(sl3_fit.ok());
-  const auto sl3 = bireg::covariance(sl3_fit, t);
-  REQUIRE(sl3.defined());
+  // Sim(3), a non-compact group: the scale's log-rate is 0.9 per unit of t,
+  // so the curve's scale exp(0.9 t) overflows from t ~ 790 and the pose's
+  // covariance with it; unbounded then, never NaN. (The compiled part holds
+  // Sim(3)'s fit and covariance: no general matrix group is instantiated
+  // here for this.)
+  const auto g = noisy_line<Sim3d>(20, 0.01, 3);
+  const auto sim3_fit = bireg::GeodesicRegression<Sim3d>().fit(g, t);
+  REQUIRE(sim3_fit.ok());
+  const auto sim3 = bireg::covariance(sim3_fit, t);
+  REQUIRE(sim3.defined());
+  bool overflowed = false;
   for (const double at : {1e3, 1e8, 1e12, 1e300}) {
     CAPTURE(at);
-    const auto pose = bireg::pose_covariance(sl3, at);
+    const auto pose = bireg::pose_covariance(sim3, at);
+    overflowed = overflowed || !pose.allFinite();
     REQUIRE(!pose.array().isNaN().any());
     REQUIRE(!bireg::standard_errors(pose).array().isNaN().any());
   }
+  REQUIRE(overflowed);  // the unbounded branch was reached
 }
 
 TEST_CASE("a local estimate that overflows is a failure not an ok NaN (issue 37 item 7)",
@@ -233,11 +239,11 @@ TEST_CASE("a local estimate that overflows is a failure not an ok NaN (issue 37 
   bireg::LocalRegressionOptions<double> options;
   options.bandwidth = 1e200;
   const auto so3 = noisy_line<SO3d>(20, 0.01, 4);
-  const auto sl3 = noisy_line<SL3d>(20, 0.01, 5);
+  const auto sim3 = noisy_line<Sim3d>(20, 0.01, 5);
   for (const double query : {1e8, 1e200, -1e200}) {
     CAPTURE(query);
     const auto a = bireg::LocalGeodesicRegression<SO3d>(options).smooth_at(so3, t, {query});
-    const auto b = bireg::LocalGeodesicRegression<SL3d>(options).smooth_at(sl3, t, {query});
+    const auto b = bireg::LocalGeodesicRegression<Sim3d>(options).smooth_at(sim3, t, {query});
     if (a[0].ok()) {
       REQUIRE(a[0].pose.allFinite());
       REQUIRE(a[0].velocity.allFinite());
@@ -253,9 +259,9 @@ TEST_CASE("a local estimate that overflows is a failure not an ok NaN (issue 37 
     if (a[0].velocity_error_defined) REQUIRE(a[0].velocity_error.allFinite());
     if (b[0].velocity_error_defined) REQUIRE(b[0].velocity_error.allFinite());
   }
-  // SL(3) at 1e8 (s ~ 5e6 local ranges out): the value overflows, so it is
+  // Sim(3) at 1e200: the scale exp(0.9 s) overflows, so the estimate is
   // reported as failed.
-  const auto far = bireg::LocalGeodesicRegression<SL3d>(options).smooth_at(sl3, t, {1e200});
+  const auto far = bireg::LocalGeodesicRegression<Sim3d>(options).smooth_at(sim3, t, {1e200});
   REQUIRE(!far[0].ok());
   REQUIRE(far[0].message.find("not representable") != std::string::npos);
 }
@@ -290,21 +296,24 @@ TEST_CASE(
   // The widest value is the covariates' range exactly.
   REQUIRE(bireg::bandwidth_grid(plain).back() == 5);
 
-  const auto f = noisy_line<SE3d>(6, 0.01, 6);
+  const auto f = noisy_line<SO3d>(6, 0.01, 6);
   const bireg::LocalRegressionOptions<double> options;
-  const auto empty = bireg::select_bandwidth<SE3d>(f, plain, options, std::vector<double>{});
+  const auto empty = bireg::select_bandwidth<SO3d>(f, plain, options, std::vector<double>{});
   REQUIRE(!empty.ok());
   REQUIRE(empty.message.find("empty") != std::string::npos);
-  const auto bad = bireg::select_bandwidth<SE3d>(f, plain, options, {1.0, nan, 2.0});
+  const auto bad = bireg::select_bandwidth<SO3d>(f, plain, options, {1.0, nan, 2.0});
   REQUIRE(!bad.ok());
   REQUIRE(bad.message.find("grid value 1") != std::string::npos);
-  // Fewer poses than SE(3)'s dimension (4 and 5): finite criteria or
-  // refusals, never NaN.
-  for (const std::size_t n : {4u, 5u}) {
-    const auto few = noisy_line<SE3d>(n, 0.01, 7);
+  // As few rotations as a fit takes (2) and one more: every leave-one-out
+  // window then holds one or two, finite criteria or refusals, never NaN.
+  // (Item 8 asked it of 3-8 SE(3) poses, which gave finite criteria when it
+  // was reported; SO(3), which this file instantiates anyway, reaches the
+  // same degenerate windows with fewer observations.)
+  for (const std::size_t n : {2u, 3u}) {
+    const auto few = noisy_line<SO3d>(n, 0.01, 7);
     const std::vector<double> t = spaced(n, 0, 1);
     const auto selection =
-        bireg::select_bandwidth<SE3d>(few, t, options, bireg::auto_bandwidth_grid(t));
+        bireg::select_bandwidth<SO3d>(few, t, options, bireg::auto_bandwidth_grid(t));
     for (const double v : selection.criterion)
       REQUIRE(!std::isnan(v));
     for (const double v : selection.velocity_criterion)
@@ -360,15 +369,15 @@ TEST_CASE("weights of 1e308 or 1e-320 give the unweighted statistics (issue 37 i
     REQUIRE(std::abs(explained.generalized - explained_plain.generalized) < 1e-12);
     REQUIRE(std::abs(explained.euclidean - explained_plain.euclidean) < 1e-12);
   }
-  // GL+(3) and SL(3): the mean of 1e308-weighted data is the unweighted mean,
-  // not observation 0.
-  const auto h = noisy_line<SL3d>(20, 0.05, 10);
-  const auto sl3_plain = bireg::mean<SL3d>(h);
-  const auto sl3_heavy = bireg::mean<SL3d>(h, std::vector<double>(20, 1e308));
-  REQUIRE(sl3_plain.ok());
-  REQUIRE(sl3_heavy.ok());
-  REQUIRE((*sl3_heavy.mean - *sl3_plain.mean).norm() < 1e-12);
-  REQUIRE((*sl3_heavy.mean - h[0]).norm() > 1e-3);
+  // Sim(3), non-compact: the mean of 1e308-weighted data is the unweighted
+  // mean, not observation 0.
+  const auto h = noisy_line<Sim3d>(20, 0.05, 10);
+  const auto sim3_plain = bireg::mean<Sim3d>(h);
+  const auto sim3_heavy = bireg::mean<Sim3d>(h, std::vector<double>(20, 1e308));
+  REQUIRE(sim3_plain.ok());
+  REQUIRE(sim3_heavy.ok());
+  REQUIRE((*sim3_heavy.mean - *sim3_plain.mean).norm() < 1e-12);
+  REQUIRE((*sim3_heavy.mean - h[0]).norm() > 1e-3);
   // A weight that is not finite is named, as fit() names it.
   std::vector<double> bad(20, 1.0);
   bad[7] = kInf;
