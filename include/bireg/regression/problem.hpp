@@ -75,6 +75,20 @@ CovariateScalar<Scalar> covariance_range_limit() {
   return sqrt(covariate_range_limit<Scalar>());
 }
 
+// Why a covariate range lies outside [limit, 1 / limit], or nothing: the
+// one check and message behind fit() (covariate_range_limit), model
+// selection (the same, before any candidate) and the covariance
+// (covariance_range_limit). `consequence` completes the message. A NaN
+// range lies outside.
+template <class Wide>
+std::optional<std::string> range_outside(Wide range, Wide limit, const char* consequence) {
+  if (range >= limit && range <= 1 / limit) return std::nullopt;
+  std::ostringstream why;
+  why << "the covariates' range " << double(range) << " lies outside [" << double(limit) << ", "
+      << double(1 / limit) << "]" << consequence << "; rescale the covariates";
+  return why.str();
+}
+
 namespace problem_detail {
 template <class Scalar>
 bool finite(Scalar x) {
@@ -145,13 +159,9 @@ std::optional<Rejection> make_problem(
   }
   // The velocity is X / range (X on the unit interval): a range outside
   // covariate_range_limit would make it overflow or underflow.
-  const Wide smallest_range = covariate_range_limit<Scalar>();
-  if (range < smallest_range || range > 1 / smallest_range) {
-    std::ostringstream why;
-    why << "the covariates' range " << double(range) << " lies outside [" << double(smallest_range)
-        << ", " << double(1 / smallest_range)
-        << "]: the velocity would overflow or underflow; rescale the covariates";
-    return Rejection{why.str()};
+  if (auto why = range_outside(range, covariate_range_limit<Scalar>(),
+                               ": the velocity would overflow or underflow")) {
+    return Rejection{*why};
   }
   problem.t.resize(n);
   problem.w.assign(n, Scalar(1));

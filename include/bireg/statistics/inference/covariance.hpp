@@ -87,7 +87,6 @@
 #include <cstddef>
 #include <limits>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -427,17 +426,9 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   // The velocity's covariance is C / range^2 for C on the unit interval:
   // beyond covariance_range_limit (1e-146 .. 1e146 in double) it overflows
   // or underflows to a zero standard error, which would be a wrong number.
-  {
-    const auto range = problem.t_max - problem.t_min;
-    const auto limit = covariance_range_limit<Scalar>();
-    if (!(range >= limit && range <= 1 / limit)) {
-      std::ostringstream why;
-      why << "the covariates' range " << double(range) << " lies outside [" << double(limit) << ", "
-          << double(1 / limit)
-          << "], where the velocity's covariance (~1/range^2) is representable; rescale the "
-             "covariates";
-      return refused<G>(CovarianceStatus::undefined, why.str());
-    }
+  if (auto why = range_outside(problem.t_max - problem.t_min, covariance_range_limit<Scalar>(),
+                               ", where the velocity's covariance (~1/range^2) is representable")) {
+    return refused<G>(CovarianceStatus::undefined, *why);
   }
 
   // nu = W - tr(H^{-1} H_2), and the matrix H^{-1} H_2 H^{-1} of the

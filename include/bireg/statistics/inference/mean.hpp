@@ -153,13 +153,13 @@ MeanResult<G> mean(const Observations& observations,
     result.bad_index = rejection->index;
     return result;
   }
-  // Weights divided by the largest, then by their sum: F is then an
-  // average, and its size comparable across data sets (scaling all weights
-  // changes nothing). Dividing by the largest first keeps the sum finite
-  // for weights of 1e308 and exact for subnormal weights such as 1e-320.
-  std::vector<Scalar> w(n, Scalar(1));
-  for (std::size_t i = 0; i < weights.size(); ++i)
-    w[i] = weights[i] / weights[heaviest];
+  // Weights divided by the largest (normalised_weights), then by their sum:
+  // F is then an average, and its size comparable across data sets
+  // (scaling all weights changes nothing). Dividing by the largest first
+  // keeps the sum finite for weights of 1e308 and exact for subnormal
+  // weights such as 1e-320.
+  std::vector<Scalar> w =
+      weights.empty() ? std::vector<Scalar>(n, Scalar(1)) : normalised_weights(weights);
   Scalar weight_sum = 0;
   for (const Scalar wi : w)
     weight_sum += wi;
