@@ -212,9 +212,10 @@ TEST_CASE(
   REQUIRE(std::abs(bireg::mahalanobis_squared(velocity, v) - v.dot(velocity.ldlt().solve(v))) <=
           1e-9 * v.dot(velocity.ldlt().solve(v)));
 
-  // Sim(3), a non-compact group: the scale's log-rate is 0.9 per unit of t,
-  // so the curve's scale exp(0.9 t) overflows from t ~ 790 and the pose's
-  // covariance with it; unbounded then, never NaN. (The compiled part holds
+  // Sim(3), a non-compact group: the scale's log grows by 0.9 over the 19
+  // units of t, so the curve's scale exp(0.9 t / 19) overflows beyond
+  // t ~ 1.5e4, and the pose's covariance with it (by t = 1e8 below at the
+  // latest); unbounded then, never NaN. (The compiled part holds
   // Sim(3)'s fit and covariance: no general matrix group is instantiated
   // here for this.)
   const auto g = noisy_line<Sim3d>(20, 0.01, 3);
@@ -259,8 +260,8 @@ TEST_CASE("a local estimate that overflows is a failure not an ok NaN (issue 37 
     if (a[0].velocity_error_defined) REQUIRE(a[0].velocity_error.allFinite());
     if (b[0].velocity_error_defined) REQUIRE(b[0].velocity_error.allFinite());
   }
-  // Sim(3) at 1e200: the scale exp(0.9 s) overflows, so the estimate is
-  // reported as failed.
+  // Sim(3) at 1e200: the scale exp(0.9 t / 19) overflows, so the estimate
+  // is reported as failed.
   const auto far = bireg::LocalGeodesicRegression<Sim3d>(options).smooth_at(sim3, t, {1e200});
   REQUIRE(!far[0].ok());
   REQUIRE(far[0].message.find("not representable") != std::string::npos);
