@@ -16,8 +16,8 @@ set(BIREG_LAYERS
   "math/ version.hpp"               # scalar numerics; the generated version header
   "groups/"                         # one header per group
   "concept.hpp"                     # what a group must provide
-  "geodesic.hpp"                    # the geodesic, Exp/Log at a point
-  "regression/ regression.hpp"      # the estimator and its facade
+  "geodesic.hpp spline.hpp"         # the curves: the geodesic, Exp/Log at a point; the spline
+  "regression/ regression.hpp spline_regression.hpp"  # the estimators and their facades
   "statistics/"                     # built on the estimator
   "io/"                             # trajectory formats
 )

@@ -1,0 +1,97 @@
+// bireg: the differentials of a cumulative B-spline with respect to its
+// control points (docs/splines.md §4-§6), per observation.
+//
+// For an observation on segment i at u, with j = c - i the control point's
+// place in the segment's product, S_j the suffix products, b_j the
+// cumulative basis and E_j = Ad_{S_j^{-1}} b_j J_r(b_j Omega_j):
+//
+//   D_0 = Ad_{S_0^{-1}} - E_1 J_l(Omega_1)^{-1}                       (the anchor)
+//   D_j = E_j J_r(Omega_j)^{-1} - E_{j+1} J_l(Omega_{j+1})^{-1},  0 < j < k
+//   D_k = E_k J_r(Omega_k)^{-1}                                         (splines.md (4))
+//
+// T(t) exp(D_c delta) is the curve after P_c -> P_c exp(delta). The
+// estimating equations weigh the residual by W_c = B_c^2 D_c^{-1} (§6), which
+// is analytic where B_c vanishes (§5). Two of them have closed forms free of
+// the cancellation that D_0 suffers as B_0 -> 0 (near the end of the
+// anchor's support), the paper's psi at s = B_0 and s = b_k (splines.md §4,
+// degree 1):
+//
+//   W_0 = s J_l(Omega_1) J_l(s Omega_1)^{-1} Ad_{S_1},  s = B_0 = 1 - b_1,
+//   W_k = b_k J_r(Omega_k) J_r(b_k Omega_k)^{-1};
+//
+// the interior ones (0 < j < k, where B_j >= 1/6 for k = 3 and >= 1/2 for
+// k = 2) are inverted as they stand.
+#pragma once
+
+#include <array>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "bireg/groups/capabilities.hpp"
+#include "bireg/spline.hpp"
+
+namespace bireg {
+
+// The Jacobians of one increment Omega, shared by every observation of
+// the segments it enters.
+template <class G>
+struct IncrementJacobians {
+  using AdMatrix = typename G::AdMatrix;
+  AdMatrix right;          // J_r(Omega)
+  AdMatrix right_inverse;  // J_r(Omega)^{-1}
+  AdMatrix left;           // J_l(Omega) = J_r(-Omega)
+  AdMatrix left_inverse;   // J_l(Omega)^{-1}
+
+  static IncrementJacobians of(const typename G::Tangent& omega) {
+    const RightJacobianPair<AdMatrix> right_pair = right_jacobian_pair<G>(omega);
+    const RightJacobianPair<AdMatrix> left_pair = right_jacobian_pair<G>((-omega).eval());
+    return {right_pair.jacobian, right_pair.inverse, left_pair.jacobian, left_pair.inverse};
+  }
+};
+
+// D_j and W_j, j = 0..k, for one observation.
+template <class G>
+struct ControlPointDifferentials {
+  using AdMatrix = typename G::AdMatrix;
+  std::array<AdMatrix, kMaxSplineDegree + 1> derivative;  // D_j
+  std::array<AdMatrix, kMaxSplineDegree + 1> weight;      // W_j = B_j^2 D_j^{-1}
+};
+
+// `jacobians` points at the Jacobians of the segment's first increment
+// (Omega_{i+1}); `product` is the segment's product at the observation.
+template <class G>
+void control_point_differentials(int degree, const SplineBasis<typename G::Scalar>& basis,
+                                 const SegmentProduct<G>& product,
+                                 const IncrementJacobians<G>* jacobians,
+                                 ControlPointDifferentials<G>& out) {
+  using AdMatrix = typename G::AdMatrix;
+  using Tangent = typename G::Tangent;
+  const int k = degree;
+  // E_j, and J_r(b_k Omega_k)^{-1} for W_k.
+  std::array<AdMatrix, kMaxSplineDegree + 1> e;
+  AdMatrix last_inverse = AdMatrix::Identity();
+  for (int j = 1; j <= k; ++j) {
+    const Tangent scaled = basis.cumulative[j] * product.omega[j];
+    const RightJacobianPair<AdMatrix> pair = right_jacobian_pair<G>(scaled);
+    e[j] = basis.cumulative[j] * (G::Ad(G::inverse(product.suffix[j])) * pair.jacobian);
+    if (j == k) last_inverse = pair.inverse;
+  }
+  const IncrementJacobians<G>& first = jacobians[0];
+  out.derivative[0] = G::Ad(G::inverse(product.suffix[0])) - e[1] * first.left_inverse;
+  for (int j = 1; j < k; ++j) {
+    out.derivative[j] =
+        e[j] * jacobians[j - 1].right_inverse - e[j + 1] * jacobians[j].left_inverse;
+  }
+  out.derivative[k] = e[k] * jacobians[k - 1].right_inverse;
+
+  const auto& b = basis.ordinary;
+  const Tangent anchor_scaled = -b[0] * product.omega[1];
+  out.weight[0] =
+      b[0] * (first.left * right_jacobian_inverse<G>(anchor_scaled)) * G::Ad(product.suffix[1]);
+  for (int j = 1; j < k; ++j)
+    out.weight[j] = (b[j] * b[j]) * out.derivative[j].inverse();
+  out.weight[k] = b[k] * (jacobians[k - 1].right * last_inverse);
+}
+
+}  // namespace bireg

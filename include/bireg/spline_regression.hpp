@@ -1,0 +1,441 @@
+// bireg: bi-invariant spline regression (docs/splines.md), the smooth
+// curve beside the geodesic of regression.hpp.
+//
+// Data (f_i, t_i, w_i) as for GeodesicRegression. The model is the
+// cumulative B-spline of spline.hpp with uniform knots over the covariates'
+// range, and the estimator the control points at which, for every c,
+//
+//   F_c = sum_i w_i B_c(t_i)^2 D_c(t_i)^{-1} log(T(t_i)^{-1} f_i) = 0      (splines.md (6))
+//
+// (D_c the differential of the curve in P_c, regression/spline/
+// differentials.hpp): Definition 2.1 of "Bi-invariant geodesic regression"
+// with one equation per control point. For degree 1 and two control points
+// it is that definition, in R^n the normal equations of least-squares
+// B-spline regression, and for every degree it is equivariant under left
+// and right translation of the data (splines.md §6; inversion for degree 1
+// only, §3). fit():
+//
+//   1. the problem (regression/problem.hpp: covariates onto [0, 1], weights
+//      normalised), the knots (S segments of equal length, the fewest whose
+//      length is at most the requested spacing), and the Schoenberg-Whitney
+//      condition, under which the linearised equations have a unique
+//      solution (§7): refused, naming the control point and its span, when
+//      some basis function's support cannot be given its own observation;
+//   2. a start: each control point P_c is the B_c-weighted mean, in the log
+//      chart at the observation nearest its Greville abscissa, of the
+//      observations in its support (left and right equivariant);
+//   3. Gauss-Newton on (6) with the block-banded Jacobian of §9,
+//      backtracking on sum_c |F_c|^2 when a full step does not reduce it.
+//
+// Errors as for GeodesicRegression::fit(): invalid input is reported as
+// Status::invalid_input with a message (and `bad_index`), a fit that does
+// not converge reports why, and nothing returns NaN.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bireg/concept.hpp"
+#include "bireg/groups/tolerance.hpp"
+#include "bireg/regression/problem.hpp"
+#include "bireg/regression/spline/banded.hpp"
+#include "bireg/regression/spline/differentials.hpp"
+#include "bireg/regression/status.hpp"
+#include "bireg/spline.hpp"
+
+namespace bireg {
+
+template <class Scalar>
+struct SplineOptions {
+  using Wide = CovariateScalar<Scalar>;
+  // Degree of the B-splines: 1 (piecewise geodesic), 2 or 3 (cubic).
+  int degree = 3;
+  // Largest knot spacing in covariate units (> 0): the range is cut into
+  // S = ceil(range / knot_spacing) equal segments. Infinity: one segment.
+  Wide knot_spacing = std::numeric_limits<Wide>::infinity();
+  // Converged when the Gauss-Newton step's largest control-point component
+  // is at or below this (absolute, in tangent coordinates, as for the
+  // geodesic).
+  Scalar tolerance = std::max(Scalar(1e-10), Scalar(64) * std::numeric_limits<Scalar>::epsilon());
+  int max_iterations = 100;
+  // The covariates mapped to the first and last knot, as for the geodesic
+  // (RegressionOptions::interval); by default their smallest and largest.
+  std::optional<std::pair<Wide, Wide>> interval;
+  Scalar element_tolerance = default_element_tolerance<Scalar>();
+};
+
+template <class G>
+struct SplineResult {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+
+  Status status = Status::invalid_input;
+  std::string message;            // what was wrong, for invalid_input and no_descent
+  std::ptrdiff_t bad_index = -1;  // offending observation, if any
+  // The fitted curve in the user's covariate units; empty for
+  // invalid_input, the last iterate for the other failures (check ok()).
+  std::optional<Spline<G>> spline;
+  int iterations = 0;              // Gauss-Newton steps proposed (the last certifies)
+  std::vector<Scalar> step_norms;  // the largest control-point component of each
+  std::vector<Tangent> residuals;  // r_i = log(T(t_i)^{-1} f_i), input order
+  // max_c |F_c| at the returned control points (splines.md (6)), weights
+  // normalised to a largest of 1.
+  Scalar equation_norm = 0;
+
+  bool ok() const { return is_success(status); }
+};
+
+template <class G>
+class SplineRegression {
+  static_assert(check_lie_group<G>());
+
+ public:
+  using Scalar = typename G::Scalar;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+  using AdMatrix = typename G::AdMatrix;
+  using Options = SplineOptions<Scalar>;
+  using Result = SplineResult<G>;
+
+  SplineRegression() = default;
+  explicit SplineRegression(Options options) : options_(std::move(options)) {}
+  const Options& options() const { return options_; }
+
+  template <class Observations, class Covariates>
+  Result fit(const Observations& observations, const Covariates& covariates,
+             const std::vector<Scalar>& weights = {}) const {
+    return run(observations, covariates, weights, nullptr);
+  }
+
+  // As fit(), from the given control points (e.g. a previous fit's, for a
+  // warm start); their number must be the one the options give.
+  template <class Observations, class Covariates>
+  Result fit_from(const std::vector<Element>& start, const Observations& observations,
+                  const Covariates& covariates, const std::vector<Scalar>& weights = {}) const {
+    return run(observations, covariates, weights, &start);
+  }
+
+ private:
+  // The knots on the unit interval: S segments of length h = 1/S.
+  struct Knots {
+    std::size_t segments = 1;
+    std::size_t control_points = 2;
+    Scalar h = 1;
+  };
+
+  // The state of the iteration at one set of control points.
+  struct Evaluation {
+    std::vector<Tangent> force;  // F_c
+    Scalar merit = 0;            // sum_c |F_c|^2
+    bool finite = true;
+  };
+
+  static Result rejected(Rejection rejection) {
+    Result result;
+    result.message = std::move(rejection.message);
+    result.bad_index = rejection.index;
+    return result;
+  }
+
+  std::optional<Rejection> validate() const {
+    using std::isfinite;
+    if (options_.degree < 1 || options_.degree > kMaxSplineDegree) {
+      return Rejection{"degree must be 1, 2 or 3, got " + std::to_string(options_.degree)};
+    }
+    if (!(options_.knot_spacing > 0)) {
+      return Rejection{"knot_spacing must be positive (infinity: one segment)"};
+    }
+    if (!(options_.tolerance >= 0) || !isfinite(options_.tolerance)) {
+      return Rejection{"tolerance must be a finite non-negative number"};
+    }
+    if (options_.max_iterations < 1) return Rejection{"max_iterations must be at least 1"};
+    if (!(options_.element_tolerance >= 0) || !isfinite(options_.element_tolerance)) {
+      return Rejection{"element_tolerance must be a finite non-negative number"};
+    }
+    return std::nullopt;
+  }
+
+  // S = ceil(range / spacing), refused where the control points would
+  // outnumber the observations (the equations could not be determined).
+  std::optional<Rejection> make_knots(const Problem<Scalar>& problem, Knots& knots) const {
+    using Wide = CovariateScalar<Scalar>;
+    using std::ceil;
+    const Wide range = problem.t_max - problem.t_min;
+    const Wide ratio = range / options_.knot_spacing;
+    const std::size_t n = problem.size();
+    const auto k = static_cast<std::size_t>(options_.degree);
+    // A spacing within rounding of range / S gives S, not S + 1.
+    const Wide segments =
+        std::max(Wide(1), ceil(ratio * (1 - 8 * std::numeric_limits<Wide>::epsilon())));
+    if (!(segments + Wide(k) <= Wide(n))) {
+      return Rejection{
+          "knot spacing " + std::to_string(double(options_.knot_spacing)) + " cuts the range " +
+          std::to_string(double(range)) + " into " + std::to_string(double(segments)) +
+          " segments: " + std::to_string(double(segments + Wide(k))) + " control points for " +
+          std::to_string(n) + " observations; use a wider spacing"};
+    }
+    knots.segments = static_cast<std::size_t>(segments);
+    knots.control_points = knots.segments + k;
+    knots.h = Scalar(1) / Scalar(knots.segments);
+    return std::nullopt;
+  }
+
+  // Schoenberg-Whitney (splines.md §7): distinct covariates s_1 < ... < s_M
+  // of positive weight with B_c(s_c) > 0 for every c. Greedy in covariate
+  // order, which finds such a choice whenever one exists; the first control
+  // point left without one is named with its support.
+  std::optional<Rejection> check_schoenberg_whitney(const Problem<Scalar>& problem,
+                                                    const std::vector<std::size_t>& order,
+                                                    const Knots& knots) const {
+    const int k = options_.degree;
+    std::size_t next = 0;  // position in `order`
+    Scalar last = -1;      // the covariate given to the previous control point
+    for (std::size_t c = 0; c < knots.control_points; ++c) {
+      bool found = false;
+      for (; next < order.size() && !found; ++next) {
+        const std::size_t i = order[next];
+        const Scalar t = problem.t[i];
+        if (!(problem.w[i] > 0) || !(t > last)) continue;
+        const KnotPosition<Scalar> at = knot_position(t, Scalar(0), knots.h, knots.segments);
+        const std::ptrdiff_t j =
+            static_cast<std::ptrdiff_t>(c) - static_cast<std::ptrdiff_t>(at.segment);
+        if (j < 0 || j > k || !(spline_basis(k, at.u).ordinary[std::size_t(j)] > 0)) continue;
+        last = t;
+        found = true;
+      }
+      if (!found) {
+        using Wide = CovariateScalar<Scalar>;
+        const Wide h = (problem.t_max - problem.t_min) / Wide(knots.segments);
+        const auto first = std::max<std::ptrdiff_t>(0, std::ptrdiff_t(c) - k);
+        const auto end = std::min<std::size_t>(c + 1, knots.segments);
+        return Rejection{
+            "control point " + std::to_string(c) + " (support [" +
+            std::to_string(double(problem.t_min + Wide(first) * h)) + ", " +
+            std::to_string(double(problem.t_min + Wide(end) * h)) +
+            "]) has no observation of positive weight of its own (Schoenberg-Whitney): the "
+            "knot spans there hold too few distinct covariates; use a wider knot spacing"};
+      }
+    }
+    return std::nullopt;
+  }
+
+  // Step 2: P_c = a_c exp(sum_i w_i B_c(t_i) log(a_c^{-1} f_i) / sum_i w_i B_c(t_i)),
+  // a_c the observation nearest c's Greville abscissa (c - (k-1)/2) h.
+  template <class Observations>
+  std::vector<Element> chart_start(const Observations& observations, const Problem<Scalar>& problem,
+                                   const std::vector<std::size_t>& order,
+                                   const Knots& knots) const {
+    const int k = options_.degree;
+    std::vector<Element> points(knots.control_points);
+    std::vector<Tangent> sums(knots.control_points, Tangent::Zero());
+    std::vector<Scalar> masses(knots.control_points, Scalar(0));
+    std::size_t nearest = 0;  // position in `order`, advanced monotonically
+    for (std::size_t c = 0; c < knots.control_points; ++c) {
+      const Scalar greville =
+          std::clamp((Scalar(c) - Scalar(k - 1) / 2) * knots.h, Scalar(0), Scalar(1));
+      while (nearest + 1 < order.size() && std::abs(problem.t[order[nearest + 1]] - greville) <=
+                                               std::abs(problem.t[order[nearest]] - greville)) {
+        ++nearest;
+      }
+      points[c] = observations[order[nearest]];
+    }
+    const std::vector<Element> anchors = points;
+    for (std::size_t i = 0; i < problem.size(); ++i) {
+      if (!(problem.w[i] > 0)) continue;
+      const KnotPosition<Scalar> at =
+          knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
+      const SplineBasis<Scalar> basis = spline_basis(k, at.u);
+      for (int j = 0; j <= k; ++j) {
+        const std::size_t c = at.segment + std::size_t(j);
+        const Scalar mass = problem.w[i] * basis.ordinary[std::size_t(j)];
+        if (!(mass > 0)) continue;
+        const Tangent offset = G::log(G::compose(G::inverse(anchors[c]), observations[i]));
+        if (!offset.allFinite()) continue;
+        sums[c] += mass * offset;
+        masses[c] += mass;
+      }
+    }
+    for (std::size_t c = 0; c < knots.control_points; ++c) {
+      if (masses[c] > 0) points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
+    }
+    return points;
+  }
+
+  // The residuals, F and sum |F|^2 at `points`; K too when `jacobian`.
+  template <class Observations>
+  Evaluation evaluate(const Observations& observations, const Problem<Scalar>& problem,
+                      const Knots& knots, const std::vector<Element>& points,
+                      std::vector<Tangent>& residuals,
+                      BlockBandedMatrix<AdMatrix, Tangent>* jacobian) const {
+    const int k = options_.degree;
+    std::vector<Tangent> increments(points.size() - 1);
+    std::vector<IncrementJacobians<G>> increment_jacobians(increments.size());
+    Evaluation evaluation;
+    evaluation.force.assign(points.size(), Tangent::Zero());
+    for (std::size_t j = 0; j < increments.size(); ++j) {
+      increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
+      if (!increments[j].allFinite()) {
+        evaluation.finite = false;
+        return evaluation;
+      }
+      increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
+    }
+    if (jacobian) jacobian->set_zero();
+    SegmentProduct<G> product;
+    ControlPointDifferentials<G> differentials;
+    for (std::size_t i = 0; i < problem.size(); ++i) {
+      const KnotPosition<Scalar> at =
+          knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
+      const SplineBasis<Scalar> basis = spline_basis(k, at.u);
+      evaluate_segment<G>(k, &increments[at.segment], basis, product);
+      const Element curve = G::compose(points[at.segment], product.suffix[0]);
+      residuals[i] = G::log(G::compose(G::inverse(curve), observations[i]));
+      const Scalar w = problem.w[i];
+      if (!(w > 0)) continue;
+      control_point_differentials<G>(k, basis, product, &increment_jacobians[at.segment],
+                                     differentials);
+      for (int j = 0; j <= k; ++j)
+        evaluation.force[at.segment + std::size_t(j)] +=
+            w * (differentials.weight[j] * residuals[i]);
+      if (!jacobian) continue;
+      // K_cl = -sum_i w_i W_c J_l(r_i)^{-1} D_l (splines.md §9).
+      const AdMatrix left_inverse = right_jacobian_inverse<G>((-residuals[i]).eval());
+      for (int j = 0; j <= k; ++j) {
+        const AdMatrix row = w * (differentials.weight[j] * left_inverse);
+        for (int l = 0; l <= k; ++l) {
+          (*jacobian)(at.segment + std::size_t(j), at.segment + std::size_t(l)).noalias() -=
+              row * differentials.derivative[l];
+        }
+      }
+    }
+    for (const Tangent& f : evaluation.force)
+      evaluation.merit += f.squaredNorm();
+    evaluation.finite = std::isfinite(evaluation.merit);
+    return evaluation;
+  }
+
+  template <class Observations, class Covariates>
+  Result run(const Observations& observations, const Covariates& covariates,
+             const std::vector<Scalar>& weights, const std::vector<Element>* start) const;
+
+  Options options_;
+};
+
+template <class G>
+template <class Observations, class Covariates>
+typename SplineRegression<G>::Result SplineRegression<G>::run(
+    const Observations& observations, const Covariates& covariates,
+    const std::vector<Scalar>& weights, const std::vector<Element>* start) const {
+  // 1. The problem, the knots, Schoenberg-Whitney.
+  if (auto rejection = validate()) return rejected(*rejection);
+  const std::size_t n = observations.size();
+  if (covariates.size() != n) {
+    return rejected({"observations and covariates differ in length (" + std::to_string(n) + " vs " +
+                     std::to_string(covariates.size()) + ")"});
+  }
+  if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
+  Problem<Scalar> problem;
+  if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
+    return rejected(*rejection);
+  }
+  if (auto rejection = check_observations<G>(observations, options_.element_tolerance)) {
+    return rejected(*rejection);
+  }
+  Knots knots;
+  if (auto rejection = make_knots(problem, knots)) return rejected(*rejection);
+  // The observations by covariate (ties by input position), for the
+  // Schoenberg-Whitney check and the start.
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return problem.t[a] < problem.t[b]; });
+  if (auto rejection = check_schoenberg_whitney(problem, order, knots)) {
+    return rejected(*rejection);
+  }
+  if (start) {
+    if (start->size() != knots.control_points) {
+      return rejected({"the start has " + std::to_string(start->size()) +
+                       " control points; the knots need " + std::to_string(knots.control_points)});
+    }
+    for (std::size_t c = 0; c < start->size(); ++c) {
+      if (!G::is_element((*start)[c], options_.element_tolerance)) {
+        return rejected(
+            {"start control point " + std::to_string(c) + " is not an element of " + G::name});
+      }
+    }
+  }
+
+  // 2. The start.
+  std::vector<Element> points = start ? *start : chart_start(observations, problem, order, knots);
+
+  // 3. Gauss-Newton with backtracking.
+  Result result;
+  result.residuals.resize(n);
+  BlockBandedMatrix<AdMatrix, Tangent> jacobian(knots.control_points, std::size_t(options_.degree));
+  Evaluation current = evaluate(observations, problem, knots, points, result.residuals, &jacobian);
+  if (!current.finite) {
+    return rejected(
+        {"the estimating equations are not finite at the start: consecutive control "
+         "points or residuals leave the domain of " +
+         std::string(G::name) + "'s log"});
+  }
+  std::vector<Tangent> step(knots.control_points), trial_residuals(n);
+  std::vector<Element> trial(knots.control_points);
+  result.status = Status::max_iterations;
+  constexpr int kHalvings = 30;
+  for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
+    ++result.iterations;
+    for (std::size_t c = 0; c < step.size(); ++c)
+      step[c] = -current.force[c];
+    if (!jacobian.solve(step)) {
+      result.status = Status::no_descent;
+      result.message = "the Gauss-Newton matrix is singular at the current control points";
+      break;
+    }
+    Scalar norm = 0;
+    for (const Tangent& s : step)
+      norm = std::max(norm, s.template lpNorm<Eigen::Infinity>());
+    result.step_norms.push_back(norm);
+    if (norm <= options_.tolerance) {
+      result.status = Status::converged;
+      break;
+    }
+    bool accepted = false;
+    Scalar scale = 1;
+    for (int halving = 0; halving <= kHalvings && !accepted; ++halving, scale /= 2) {
+      for (std::size_t c = 0; c < points.size(); ++c)
+        trial[c] = G::compose(points[c], G::exp(scale * step[c]));
+      Evaluation next = evaluate(observations, problem, knots, trial, trial_residuals, nullptr);
+      if (next.finite && next.merit < current.merit) {
+        accepted = true;
+        points.swap(trial);
+        result.residuals.swap(trial_residuals);
+      }
+    }
+    if (!accepted) {
+      // No step reduces |F|: at the rounding floor when the step is at the
+      // data's precision, otherwise outside the estimator's domain.
+      const bool floor = norm <= std::sqrt(std::numeric_limits<Scalar>::epsilon());
+      result.status = floor ? Status::rounding_floor : Status::no_descent;
+      if (!floor) result.message = "no step along the Gauss-Newton direction reduces |F|";
+      break;
+    }
+    current = evaluate(observations, problem, knots, points, result.residuals, &jacobian);
+  }
+  for (const Tangent& f : current.force)
+    result.equation_norm = std::max(result.equation_norm, f.norm());
+  using Wide = CovariateScalar<Scalar>;
+  const Wide h = (problem.t_max - problem.t_min) / Wide(knots.segments);
+  result.spline = Spline<G>(options_.degree, static_cast<Scalar>(problem.t_min),
+                            static_cast<Scalar>(h), std::move(points));
+  return result;
+}
+
+}  // namespace bireg
