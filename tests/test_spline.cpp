@@ -6,6 +6,7 @@
 // least-squares B-spline regression, solved here independently), left and
 // right equivariance of the fit, inversion for degree 1 and its
 // second-order failure for degree 3, and the refusals.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -20,6 +21,7 @@
 #include "bireg/regression.hpp"
 #include "bireg/spline.hpp"
 #include "bireg/spline_regression.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
 
@@ -391,4 +393,65 @@ TEST_CASE("Spline fit refuses what it cannot determine, naming it", "[spline]") 
   fit = bireg::SplineRegression<SO3>(options).fit(f, t);
   CHECK(fit.bad_index == 4);
   CHECK(fit.message.find("non-finite") != std::string::npos);
+}
+
+// Cross-validation of the knot spacing (statistics/smoothing/spline_knots.hpp):
+// the same choice and criteria for translated data, a spacing too fine for
+// the folds refused with its reason, and a choice whose curve is close to
+// the best the grid offers against the truth (which the criterion cannot
+// see).
+TEST_CASE("Knot spacing by cross-validation: invariant and refusals stated", "[spline]") {
+  std::mt19937 rng(31);
+  const bireg::Spline<SO3> truth(3, 0.0, 1.0, random_points<SO3>(rng, 8, 0.5));
+  const Samples<SO3> data = sample(truth, 150, 0.05, rng);
+  const std::vector<double> grid = {0.04, 0.25, 0.5, 1.0, 2.0, 5.0};
+  bireg::SplineOptions<double> options;
+  const auto selection = bireg::select_knot_spacing<SO3>(data.f, data.t, options, grid);
+  REQUIRE(selection.ok());
+  // 0.04 cuts ~5 into ~125 segments: 128 control points for 150
+  // observations, spans with about one each.
+  INFO(selection.refusals[0]);
+  CHECK(selection.refusals[0].find("the knots are too dense for the data") != std::string::npos);
+  CHECK(selection.failures[0] > 0);
+  std::size_t best = grid.size();
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    if (!selection.refusals[v].empty()) continue;
+    CHECK(std::isfinite(selection.criterion[v]));
+    if (best == grid.size() || selection.criterion[v] < selection.criterion[best]) best = v;
+  }
+  REQUIRE(best < grid.size());
+  CHECK(selection.knot_spacing == grid[best]);
+
+  const SO3::Element g = SO3::exp(SO3::Tangent(0.3, -1.1, 0.7));
+  auto left = data.f, right = data.f;
+  for (std::size_t i = 0; i < left.size(); ++i) {
+    left[i] = SO3::compose(g, data.f[i]);
+    right[i] = SO3::compose(data.f[i], g);
+  }
+  for (const auto& moved : {left, right}) {
+    const auto other = bireg::select_knot_spacing<SO3>(moved, data.t, options, grid);
+    REQUIRE(other.ok());
+    CHECK(other.knot_spacing == selection.knot_spacing);
+    for (std::size_t v = 0; v < grid.size(); ++v) {
+      if (!std::isfinite(selection.criterion[v])) continue;
+      CHECK(std::abs(other.criterion[v] / selection.criterion[v] - 1) < 1e-8);
+    }
+  }
+
+  // Against the truth: the chosen curve's RMS error within 1.5x of the
+  // best grid value's.
+  std::vector<double> errors;
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    options.knot_spacing = grid[v];
+    const auto fit = bireg::SplineRegression<SO3>(options).fit(data.f, data.t);
+    double sum = 0;
+    for (int q = 0; q <= 200 && fit.ok(); ++q) {
+      const double t = data.t.front() + (data.t.back() - data.t.front()) * q / 200;
+      sum += std::pow(distance<SO3>((*fit.spline)(t), truth(t)), 2);
+    }
+    errors.push_back(fit.ok() ? std::sqrt(sum / 201) : INFINITY);
+  }
+  const double oracle = *std::min_element(errors.begin(), errors.end());
+  INFO("chosen " << selection.knot_spacing << " error " << errors[best] << ", best " << oracle);
+  CHECK(errors[best] <= 1.5 * oracle);
 }

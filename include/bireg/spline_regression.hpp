@@ -132,9 +132,18 @@ class SplineRegression {
 
   // The state of the iteration at one set of control points.
   struct Evaluation {
+    explicit Evaluation(std::size_t control_points) : force(control_points, Tangent::Zero()) {}
     std::vector<Tangent> force;  // F_c
     Scalar merit = 0;            // sum_c |F_c|^2
     bool finite = true;
+  };
+
+  // Per-increment scratch of evaluate(), allocated once per fit.
+  struct Scratch {
+    explicit Scratch(std::size_t control_points)
+        : increments(control_points - 1), jacobians(control_points - 1) {}
+    std::vector<Tangent> increments;
+    std::vector<IncrementJacobians<G>> jacobians;
   };
 
   static Result rejected(Rejection rejection) {
@@ -268,22 +277,24 @@ class SplineRegression {
     return points;
   }
 
-  // The residuals, F and sum |F|^2 at `points`; K too when `jacobian`.
+  // The residuals, F and sum |F|^2 at `points` into `evaluation`; K too
+  // when `jacobian`. `increments` and `jacobians` are scratch, sized once.
   template <class Observations>
-  Evaluation evaluate(const Observations& observations, const Problem<Scalar>& problem,
-                      const Knots& knots, const std::vector<Element>& points,
-                      std::vector<Tangent>& residuals,
-                      BlockBandedMatrix<AdMatrix, Tangent>* jacobian) const {
+  void evaluate(const Observations& observations, const Problem<Scalar>& problem,
+                const Knots& knots, const std::vector<Element>& points,
+                std::vector<Tangent>& residuals, BlockBandedMatrix<AdMatrix, Tangent>* jacobian,
+                Scratch& scratch, Evaluation& evaluation) const {
     const int k = options_.degree;
-    std::vector<Tangent> increments(points.size() - 1);
-    std::vector<IncrementJacobians<G>> increment_jacobians(increments.size());
-    Evaluation evaluation;
-    evaluation.force.assign(points.size(), Tangent::Zero());
+    std::vector<Tangent>& increments = scratch.increments;
+    std::vector<IncrementJacobians<G>>& increment_jacobians = scratch.jacobians;
+    std::fill(evaluation.force.begin(), evaluation.force.end(), Tangent::Zero());
+    evaluation.merit = 0;
+    evaluation.finite = true;
     for (std::size_t j = 0; j < increments.size(); ++j) {
       increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
       if (!increments[j].allFinite()) {
         evaluation.finite = false;
-        return evaluation;
+        return;
       }
       increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
     }
@@ -318,7 +329,41 @@ class SplineRegression {
     for (const Tangent& f : evaluation.force)
       evaluation.merit += f.squaredNorm();
     evaluation.finite = std::isfinite(evaluation.merit);
-    return evaluation;
+  }
+
+  // Why no step reduced |F|, from what the last iterate shows: residuals
+  // near a half turn (the curve cannot follow the data: knots too sparse
+  // for the motion, or the data leave the log's domain) or a step far
+  // larger than the data's spread (the equations are nearly singular:
+  // knots too dense for the data).
+  static std::string no_descent_message(const std::vector<Tangent>& residuals,
+                                        const std::vector<Tangent>& step) {
+    constexpr Scalar kHalfTurn = Scalar(3.14159265358979323846);
+    std::ptrdiff_t far = -1;
+    Scalar farthest = 0;
+    for (std::size_t i = 0; i < residuals.size(); ++i) {
+      const Scalar radius = ad_spectral_radius<G>(residuals[i]);
+      if (radius > farthest) far = static_cast<std::ptrdiff_t>(i), farthest = radius;
+    }
+    std::string why = "no step along the Gauss-Newton direction reduces |F|: ";
+    if (farthest > kHalfTurn / 2) {
+      return why + "observation " + std::to_string(far) + " lies " +
+             std::to_string(double(farthest)) +
+             " rad from the curve (spectral radius of ad of its residual): the knots are too "
+             "sparse for the motion, or the data leave the domain of " +
+             G::name + "'s log; try a narrower knot spacing";
+    }
+    Scalar largest = 0;
+    for (const Tangent& s : step)
+      largest = std::max(largest, s.template lpNorm<Eigen::Infinity>());
+    if (largest > 1) {
+      return why + "the equations are nearly singular (proposed step " +
+             std::to_string(double(largest)) +
+             " rad): the knots are too dense for the data (spans with about one observation); "
+             "try a wider knot spacing";
+    }
+    return why + "the largest residual is " + std::to_string(double(farthest)) +
+           " rad; the equations have no solution reachable from the start at this knot spacing";
   }
 
   template <class Observations, class Covariates>
@@ -379,7 +424,10 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   Result result;
   result.residuals.resize(n);
   BlockBandedMatrix<AdMatrix, Tangent> jacobian(knots.control_points, std::size_t(options_.degree));
-  Evaluation current = evaluate(observations, problem, knots, points, result.residuals, &jacobian);
+  BlockBandedMatrix<AdMatrix, Tangent> trial_jacobian = jacobian;
+  Scratch scratch(knots.control_points);
+  Evaluation current(knots.control_points), next(knots.control_points);
+  evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
   if (!current.finite) {
     return rejected(
         {"the estimating equations are not finite at the start: consecutive control "
@@ -412,11 +460,22 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
     for (int halving = 0; halving <= kHalvings && !accepted; ++halving, scale /= 2) {
       for (std::size_t c = 0; c < points.size(); ++c)
         trial[c] = G::compose(points[c], G::exp(scale * step[c]));
-      Evaluation next = evaluate(observations, problem, knots, trial, trial_residuals, nullptr);
+      // The full step's trial assembles K as it goes (it is usually
+      // taken); a halved one only F, and K is assembled once it is taken.
+      const bool full_step = halving == 0;
+      evaluate(observations, problem, knots, trial, trial_residuals,
+               full_step ? &trial_jacobian : nullptr, scratch, next);
       if (next.finite && next.merit < current.merit) {
         accepted = true;
         points.swap(trial);
         result.residuals.swap(trial_residuals);
+        std::swap(current, next);
+        if (full_step) {
+          std::swap(jacobian, trial_jacobian);
+        } else {
+          evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch,
+                   current);
+        }
       }
     }
     if (!accepted) {
@@ -424,10 +483,9 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       // data's precision, otherwise outside the estimator's domain.
       const bool floor = norm <= std::sqrt(std::numeric_limits<Scalar>::epsilon());
       result.status = floor ? Status::rounding_floor : Status::no_descent;
-      if (!floor) result.message = "no step along the Gauss-Newton direction reduces |F|";
+      if (!floor) result.message = no_descent_message(result.residuals, step);
       break;
     }
-    current = evaluate(observations, problem, knots, points, result.residuals, &jacobian);
   }
   for (const Tangent& f : current.force)
     result.equation_norm = std::max(result.equation_norm, f.norm());

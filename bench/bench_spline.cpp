@@ -1,0 +1,91 @@
+// Benchmarks of the spline regression (issue 32's performance targets):
+//   * SO(3), N = 1e5 samples, a knot every 10 samples, a cubic spline fit on
+//     one thread (target: at most 1 s);
+//   * its cost per observation and Gauss-Newton iteration against the
+//     geodesic fit's on the same observations (target: at most 3x).
+// The data are bench_local_regression's: exp(0.5 (sin w t, cos w t - 1,
+// sin 2 w t)) with w = 2 pi / 10 s sampled at 1 kHz, noise 0.01 rad per
+// axis, seed 7.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "bireg/groups/so3.hpp"
+#include "bireg/regression.hpp"
+#include "bireg/spline_regression.hpp"
+#include "bireg/testing/random.hpp"
+
+namespace {
+
+using G = bireg::SO3d;
+
+struct Data {
+  std::vector<G::Element> f;
+  std::vector<double> t;
+};
+
+constexpr double kSpacing = 1e-3;  // s: 1 kHz
+
+Data curve(int n) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, 0.01);
+  const double w = 2 * M_PI / 10;
+  Data data;
+  for (int i = 0; i < n; ++i) {
+    const double t = i * kSpacing;
+    const G::Tangent c =
+        0.5 * G::Tangent(std::sin(w * t), std::cos(w * t) - 1, std::sin(2 * w * t));
+    const G::Tangent e = bireg::testing::draw_vector<G::Tangent>(rng, normal);
+    data.t.push_back(t);
+    data.f.push_back(G::compose(G::exp(c), G::exp(e)));
+  }
+  return data;
+}
+
+// Counters shared by both fits: Gauss-Newton steps proposed (the last
+// certifies), and the time per observation and step.
+void count(benchmark::State& state, double n, int iterations) {
+  state.counters["iterations"] = iterations;
+  state.counters["per_observation_iteration"] =
+      benchmark::Counter(n * iterations, benchmark::Counter::kIsIterationInvariantRate |
+                                             benchmark::Counter::kInvert);
+}
+
+void BM_CubicSplineFit(benchmark::State& state) {
+  const Data data = curve(static_cast<int>(state.range(0)));
+  bireg::SplineOptions<double> options;
+  options.degree = 3;
+  options.knot_spacing = 10 * kSpacing;
+  const bireg::SplineRegression<G> regression(options);
+  int iterations = 0;
+  for (auto _ : state) {
+    const auto fit = regression.fit(data.f, data.t);
+    if (!fit.ok()) state.SkipWithError(fit.message.c_str());
+    iterations = fit.iterations;
+    benchmark::DoNotOptimize(fit.spline);
+  }
+  count(state, static_cast<double>(data.t.size()), iterations);
+}
+BENCHMARK(BM_CubicSplineFit)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+// The geodesic on the same observations (the whole curve, one geodesic:
+// large residuals, the same per-observation work).
+void BM_GeodesicFit(benchmark::State& state) {
+  const Data data = curve(static_cast<int>(state.range(0)));
+  const bireg::GeodesicRegression<G> regression;
+  int iterations = 0;
+  for (auto _ : state) {
+    const auto fit = regression.fit(data.f, data.t);
+    if (!fit.ok()) state.SkipWithError(fit.message.c_str());
+    iterations = fit.iterations;
+    benchmark::DoNotOptimize(fit.geodesic);
+  }
+  count(state, static_cast<double>(data.t.size()), iterations);
+}
+BENCHMARK(BM_GeodesicFit)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,203 @@
+// bireg: the knot spacing of a spline regression (bireg/spline_regression.hpp)
+// by cross-validation, the criterion of the local regression's bandwidth
+// (statistics/smoothing/bandwidth.hpp).
+//
+// The observations, in covariate order, are dealt into F folds (the r-th
+// into fold r mod F: every fold spans the whole range, so no fold leaves a
+// knot span empty by construction). For each spacing on the grid, each
+// fold is held out in turn and the spline is fitted to the rest on the
+// knots of the full data (the interval is fixed to the data's range, so
+// the held-out covariates stay inside), warm-started from the full fit;
+// the prediction errors e_i = log(T(t_i)^{-1} f_i) of the held-out
+// observations give S = (1/N) sum e_i e_i^T and the criterion det(S)^(1/d).
+// Left translation of the data leaves every e_i unchanged; right
+// translation by g maps it to Ad_{g^{-1}} e_i and multiplies every det(S)
+// by the same det(Ad_{g^{-1}})^2, so the choice is left and right
+// invariant.
+//
+// A spacing is refused only for a stated reason: its full fit or one of
+// its folds' fits failed (the message of the first failure is kept, e.g.
+// a fold whose observations leave a knot span without data), and every
+// refusal is reported. Once the fit to all observations fails at some
+// spacing after succeeding at a narrower one, the wider spacings are not
+// tried (refused as "not tried"): knots too sparse for the motion only get
+// sparser, and each failing fit costs its iteration limit. The choice is the smallest criterion
+// among the spacings not refused.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "bireg/spline_regression.hpp"
+
+namespace bireg {
+
+template <class Scalar>
+struct KnotSpacingSelection {
+  Scalar knot_spacing = 0;   // the choice (0: none)
+  std::vector<Scalar> grid;  // ascending
+  // det(S)^(1/d) per grid value; infinite where refused.
+  std::vector<Scalar> criterion;
+  // Per grid value: the fits that failed (the full fit counts as one) and
+  // why the value was refused (empty: it was not).
+  std::vector<std::size_t> failures;
+  std::vector<std::string> refusals;
+  // The choice is the grid's first or last value: the best may lie beyond.
+  bool at_edge = false;
+  // What a user should be told (a choice at the edge, why nothing could be
+  // chosen); empty when there is nothing to say.
+  std::string message;
+  bool ok() const { return knot_spacing > 0; }
+};
+
+// 24 spacings, geometric, from 1.25 median covariate spacings (fewer
+// control points than observations) to the whole range (one segment).
+template <class Scalar>
+std::vector<Scalar> auto_knot_spacing_grid(std::vector<Scalar> covariates) {
+  std::vector<Scalar> grid;
+  std::sort(covariates.begin(), covariates.end());
+  if (covariates.size() < 2) return grid;
+  std::vector<Scalar> gaps;
+  for (std::size_t i = 1; i < covariates.size(); ++i) {
+    if (covariates[i] > covariates[i - 1]) gaps.push_back(covariates[i] - covariates[i - 1]);
+  }
+  const Scalar range = covariates.back() - covariates.front();
+  if (gaps.empty() || !(range > 0)) return grid;
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  const Scalar smallest = std::min(range, Scalar(1.25) * gaps[gaps.size() / 2]);
+  constexpr int kValues = 24;
+  for (int v = 0; v < kValues; ++v)
+    grid.push_back(smallest * std::pow(range / smallest, Scalar(v) / Scalar(kValues - 1)));
+  return grid;
+}
+
+// Cross-validates the grid (ascending, positive) with `folds` folds (at
+// least 2). `options` gives everything but the spacing and the interval.
+template <class G, class Observations, class Covariates>
+KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
+    const Observations& observations, const Covariates& covariates,
+    const SplineOptions<typename G::Scalar>& options, const std::vector<typename G::Scalar>& grid,
+    std::size_t folds = 5) {
+  using Scalar = typename G::Scalar;
+  using Element = typename G::Element;
+  using Tangent = typename G::Tangent;
+  using Covariance = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  KnotSpacingSelection<Scalar> selection;
+  selection.grid = grid;
+  const std::size_t n = observations.size();
+  if (grid.empty() || folds < 2 || covariates.size() != n || n < 2 * folds) {
+    selection.message =
+        "knot spacing selection needs a grid, at least 2 folds and at least 2 "
+        "observations per fold";
+    return selection;
+  }
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    if (!(grid[v] > 0) || (v > 0 && !(grid[v] > grid[v - 1]))) {
+      selection.message =
+          "the knot spacing grid must be positive and ascending (value " + std::to_string(v) + ")";
+      return selection;
+    }
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return covariates[a] < covariates[b]; });
+  std::vector<std::size_t> fold_of(n);
+  for (std::size_t r = 0; r < n; ++r)
+    fold_of[order[r]] = r % folds;
+  SplineOptions<Scalar> fixed = options;
+  fixed.interval = std::make_pair(CovariateScalar<Scalar>(covariates[order.front()]),
+                                  CovariateScalar<Scalar>(covariates[order.back()]));
+
+  std::vector<Element> train_f;
+  std::vector<Scalar> train_t;
+  bool fitted = false;          // a narrower spacing's fit to all observations succeeded
+  Scalar failed_after_fit = 0;  // the first spacing whose fit failed after one succeeded
+  for (const Scalar spacing : grid) {
+    if (failed_after_fit > 0) {
+      selection.criterion.push_back(std::numeric_limits<Scalar>::infinity());
+      selection.failures.push_back(0);
+      selection.refusals.push_back(
+          "not tried: the fit to all observations failed at the narrower spacing " +
+          std::to_string(double(failed_after_fit)) + " after a narrower one succeeded");
+      continue;
+    }
+    fixed.knot_spacing = spacing;
+    const SplineRegression<G> regression(fixed);
+    std::size_t failures = 0;
+    std::string refusal;
+    const auto full = regression.fit(observations, covariates);
+    if (full.ok()) fitted = true;
+    if (!full.ok() && fitted) failed_after_fit = spacing;
+    if (!full.ok()) {
+      failures = 1;
+      refusal = std::string("the fit to all observations: ") +
+                (full.message.empty() ? to_string(full.status) : full.message);
+    }
+    Covariance scatter = Covariance::Zero();
+    for (std::size_t fold = 0; fold < folds && full.ok(); ++fold) {
+      train_f.clear();
+      train_t.clear();
+      for (std::size_t i = 0; i < n; ++i) {
+        if (fold_of[i] == fold) continue;
+        train_f.push_back(observations[i]);
+        train_t.push_back(covariates[i]);
+      }
+      const auto fit = regression.fit_from(full.spline->control_points(), train_f, train_t);
+      if (!fit.ok()) {
+        ++failures;
+        if (refusal.empty()) {
+          refusal = "fold " + std::to_string(fold) + ": " +
+                    (fit.message.empty() ? to_string(fit.status) : fit.message);
+        }
+        continue;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        if (fold_of[i] != fold) continue;
+        const Tangent e =
+            G::log(G::compose(G::inverse((*fit.spline)(Scalar(covariates[i]))), observations[i]));
+        scatter.noalias() += e * e.transpose();
+      }
+    }
+    Scalar criterion = std::numeric_limits<Scalar>::infinity();
+    if (refusal.empty()) {
+      using std::pow;
+      const Scalar determinant = (scatter / Scalar(n)).determinant();
+      if (determinant > 0 && std::isfinite(determinant)) {
+        criterion = pow(determinant, Scalar(1) / Scalar(G::dof));
+      } else {
+        refusal = "the prediction errors' covariance is singular or not finite";
+      }
+    }
+    selection.criterion.push_back(criterion);
+    selection.failures.push_back(failures);
+    selection.refusals.push_back(refusal);
+  }
+  std::size_t best = grid.size();
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    if (!selection.refusals[v].empty()) continue;
+    if (best == grid.size() || selection.criterion[v] < selection.criterion[best]) best = v;
+  }
+  if (best == grid.size()) {
+    selection.message = "every knot spacing was refused; the first: " + selection.refusals[0];
+    return selection;
+  }
+  selection.knot_spacing = grid[best];
+  selection.at_edge = best == 0 || best + 1 == grid.size();
+  if (selection.at_edge) {
+    selection.message = std::string("the chosen knot spacing is the grid's ") +
+                        (best == 0 ? "smallest" : "largest") +
+                        " value: the best may lie beyond the grid";
+  }
+  return selection;
+}
+
+}  // namespace bireg
