@@ -21,7 +21,10 @@
 //   bireg: LocalGeodesicRegression<SO3>, Gaussian kernel, what
 //     `bireg_smooth --bandwidth auto` does: select_bandwidth over 20 values
 //     from half a median sample spacing to the whole range, the velocity
-//     smoothed at the velocity's choice.
+//     smoothed at the velocity's choice;
+//   the cubic spline: SplineRegression<SO3>, degree 3, its knot spacing by
+//     select_knot_spacing over auto_knot_spacing_grid (5 folds), its
+//     velocity at every sample.
 // Prints the RMS error |w - w_gyro| over all samples (rad/s) and the chosen
 // bandwidths: for the 128 Hz recording, for it subsampled to 50 and 25 Hz
 // (fast relative to the sampling: up to 0.2 and 0.4 rad between samples),
@@ -39,6 +42,7 @@
 
 #include "bireg/groups/so3.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "bireg/testing/fast_motion.hpp"
 #include "svg_plot.hpp"
 
@@ -122,6 +126,27 @@ bool write_plot_svg(const std::string& path, double from, double to, double nois
   return static_cast<bool>(out);
 }
 
+// The cubic spline's column: its velocity's RMS error at the knot spacing
+// chosen by cross-validation (statistics/smoothing/spline_knots.hpp), or
+// why there is none.
+std::string spline_cell(const std::vector<SO3::Element>& r, const std::vector<double>& t,
+                        const std::vector<Vector3>& truth) {
+  bireg::SplineOptions<double> options;
+  const auto selection =
+      bireg::select_knot_spacing<SO3>(r, t, options, bireg::auto_knot_spacing_grid(t));
+  if (!selection.ok()) return "no spacing: " + selection.message;
+  options.knot_spacing = selection.knot_spacing;
+  const auto fit = bireg::SplineRegression<SO3>(options).fit(r, t);
+  if (!fit.ok()) return std::string("failed: ") + bireg::to_string(fit.status);
+  std::vector<Vector3> velocity;
+  for (const double ti : t)
+    velocity.push_back(fit.spline->body_velocity(ti));
+  char cell[48];
+  std::snprintf(cell, sizeof cell, "%.3f (%.4f)", rms_error(velocity, truth),
+                selection.knot_spacing);
+  return cell;
+}
+
 // One row of the table: the three estimators' RMS errors against `truth`
 // and bireg's bandwidths. Returns bireg's velocities (empty on failure).
 std::vector<Vector3> print_row(const std::string& label, double noise,
@@ -135,10 +160,10 @@ std::vector<Vector3> print_row(const std::string& label, double noise,
                  label.c_str(), noise, smoothed.failed);
     return {};
   }
-  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f | %.2f |\n", label.c_str(), noise,
-              rms_error(differences, truth), chart, chart_bandwidth,
+  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f | %.2f | %s |\n", label.c_str(),
+              noise, rms_error(differences, truth), chart, chart_bandwidth,
               rms_error(smoothed.velocity, truth), smoothed.pose_bandwidth, smoothed.bandwidth,
-              smoothed.mean_iterations);
+              smoothed.mean_iterations, spline_cell(r, t, truth).c_str());
   return smoothed.velocity;
 }
 
@@ -170,7 +195,8 @@ int main(int argc, char** argv) {
   const char* header =
       "| recording | orientation noise (rad) | finite differences RMS (rad/s) | chart line "
       "RMS, best bandwidth (s) | bireg RMS (rad/s) | bireg bandwidths, pose and velocity (s) "
-      "| GN iterations per query |\n|---|---|---|---|---|---|---|\n";
+      "| GN iterations per query | cubic spline RMS, knot spacing (s) |\n"
+      "|---|---|---|---|---|---|---|---|\n";
   std::printf("%s", header);
   std::mt19937 rng(20261123);
   std::normal_distribution<double> normal(0.0, 1.0);
