@@ -455,3 +455,26 @@ TEST_CASE("Knot spacing by cross-validation: invariant and refusals stated", "[s
   INFO("chosen " << selection.knot_spacing << " error " << errors[best] << ", best " << oracle);
   CHECK(errors[best] <= 1.5 * oracle);
 }
+
+// Threads share the chunks of each pass; the chunks and the order their
+// sums are added in do not depend on the thread count (parallel.hpp).
+TEST_CASE("Spline fit: bit-identical for any thread count", "[spline][threads]") {
+  std::mt19937 rng(37);
+  const bireg::Spline<SO3> truth(3, 0.0, 1.0, random_points<SO3>(rng, 40, 0.3));
+  const Samples<SO3> data = sample(truth, 3 * bireg::kChunkSize, 0.05, rng);
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = 0.5;
+  const auto serial = bireg::SplineRegression<SO3>(options).fit(data.f, data.t);
+  REQUIRE(serial.ok());
+  for (const int threads : {2, 3}) {
+    options.threads = threads;
+    const auto parallel = bireg::SplineRegression<SO3>(options).fit(data.f, data.t);
+    REQUIRE(parallel.ok());
+    CHECK(parallel.iterations == serial.iterations);
+    for (std::size_t c = 0; c < serial.spline->control_points().size(); ++c)
+      CHECK(parallel.spline->control_points()[c] == serial.spline->control_points()[c]);
+  }
+  options.threads = 0;
+  CHECK(bireg::SplineRegression<SO3>(options).fit(data.f, data.t).message ==
+        "threads must be at least 1, got 0");
+}

@@ -44,6 +44,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/spline/banded.hpp"
 #include "bireg/regression/spline/differentials.hpp"
@@ -69,6 +70,10 @@ struct SplineOptions {
   // (RegressionOptions::interval); by default their smallest and largest.
   std::optional<std::pair<Wide, Wide>> interval;
   Scalar element_tolerance = default_element_tolerance<Scalar>();
+  // Threads for the passes over the observations (regression/parallel.hpp),
+  // at least 1; from kParallelMinimum observations on. The results are
+  // bit-identical for any value.
+  int threads = 1;
 };
 
 template <class G>
@@ -138,12 +143,49 @@ class SplineRegression {
     bool finite = true;
   };
 
-  // Per-increment scratch of evaluate(), allocated once per fit.
+  // One chunk's share of F and K (parallel.hpp's chunks of the
+  // observations in covariate order): the control points [first, first +
+  // force.size()), and K's rows for them laid out as BlockBandedMatrix's.
+  struct ChunkPartial {
+    std::size_t begin = 0, end = 0;  // positions in the covariate order
+    std::size_t first = 0;
+    std::vector<Tangent> force;
+    std::vector<Scalar> mass;  // the start's sums of weights
+    std::vector<AdMatrix> blocks;
+  };
+
+  // What evaluate() works in, allocated once per fit: the increments and
+  // their Jacobians, the observations in covariate order and the chunks'
+  // partial sums, and the pool that computes them.
   struct Scratch {
-    explicit Scratch(std::size_t control_points)
-        : increments(control_points - 1), jacobians(control_points - 1) {}
+    Scratch(const Problem<Scalar>& problem, const Knots& knots, std::vector<std::size_t> sorted,
+            int degree, ChunkPool* chunk_pool)
+        : increments(knots.control_points - 1),
+          jacobians(knots.control_points - 1),
+          order(std::move(sorted)),
+          partials(chunk_count(order.size())),
+          pool(chunk_pool) {
+      const auto k = static_cast<std::size_t>(degree);
+      for (std::size_t chunk = 0; chunk < partials.size(); ++chunk) {
+        ChunkPartial& partial = partials[chunk];
+        partial.begin = chunk * kChunkSize;
+        partial.end = std::min(order.size(), partial.begin + kChunkSize);
+        const auto segment = [&](std::size_t position) {
+          return knot_position(problem.t[order[position]], Scalar(0), knots.h, knots.segments)
+              .segment;
+        };
+        partial.first = segment(partial.begin);
+        const std::size_t rows = segment(partial.end - 1) + k + 1 - partial.first;
+        partial.force.assign(rows, Tangent::Zero());
+        partial.mass.assign(rows, Scalar(0));
+        partial.blocks.assign(rows * (2 * k + 1), AdMatrix::Zero());
+      }
+    }
     std::vector<Tangent> increments;
     std::vector<IncrementJacobians<G>> jacobians;
+    std::vector<std::size_t> order;
+    std::vector<ChunkPartial> partials;
+    ChunkPool* pool;
   };
 
   static Result rejected(Rejection rejection) {
@@ -165,6 +207,9 @@ class SplineRegression {
       return Rejection{"tolerance must be a finite non-negative number"};
     }
     if (options_.max_iterations < 1) return Rejection{"max_iterations must be at least 1"};
+    if (options_.threads < 1) {
+      return Rejection{"threads must be at least 1, got " + std::to_string(options_.threads)};
+    }
     if (!(options_.element_tolerance >= 0) || !isfinite(options_.element_tolerance)) {
       return Rejection{"element_tolerance must be a finite non-negative number"};
     }
@@ -236,15 +281,14 @@ class SplineRegression {
   }
 
   // Step 2: P_c = a_c exp(sum_i w_i B_c(t_i) log(a_c^{-1} f_i) / sum_i w_i B_c(t_i)),
-  // a_c the observation nearest c's Greville abscissa (c - (k-1)/2) h.
+  // a_c the observation nearest c's Greville abscissa (c - (k-1)/2) h; the
+  // sums by chunks as in evaluate().
   template <class Observations>
   std::vector<Element> chart_start(const Observations& observations, const Problem<Scalar>& problem,
-                                   const std::vector<std::size_t>& order,
-                                   const Knots& knots) const {
+                                   const Knots& knots, Scratch& scratch) const {
     const int k = options_.degree;
-    std::vector<Element> points(knots.control_points);
-    std::vector<Tangent> sums(knots.control_points, Tangent::Zero());
-    std::vector<Scalar> masses(knots.control_points, Scalar(0));
+    const std::vector<std::size_t>& order = scratch.order;
+    std::vector<Element> anchors(knots.control_points);
     std::size_t nearest = 0;  // position in `order`, advanced monotonically
     for (std::size_t c = 0; c < knots.control_points; ++c) {
       const Scalar greville =
@@ -253,76 +297,139 @@ class SplineRegression {
                                                std::abs(problem.t[order[nearest]] - greville)) {
         ++nearest;
       }
-      points[c] = observations[order[nearest]];
+      anchors[c] = observations[order[nearest]];
     }
-    const std::vector<Element> anchors = points;
-    for (std::size_t i = 0; i < problem.size(); ++i) {
-      if (!(problem.w[i] > 0)) continue;
-      const KnotPosition<Scalar> at =
-          knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
-      const SplineBasis<Scalar> basis = spline_basis(k, at.u);
-      for (int j = 0; j <= k; ++j) {
-        const std::size_t c = at.segment + std::size_t(j);
-        const Scalar mass = problem.w[i] * basis.ordinary[std::size_t(j)];
-        if (!(mass > 0)) continue;
-        const Tangent offset = G::log(G::compose(G::inverse(anchors[c]), observations[i]));
-        if (!offset.allFinite()) continue;
-        sums[c] += mass * offset;
-        masses[c] += mass;
+    const auto chunk_sum = [&](std::size_t chunk) {
+      ChunkPartial& partial = scratch.partials[chunk];
+      std::fill(partial.force.begin(), partial.force.end(), Tangent::Zero());
+      std::fill(partial.mass.begin(), partial.mass.end(), Scalar(0));
+      for (std::size_t position = partial.begin; position < partial.end; ++position) {
+        const std::size_t i = order[position];
+        if (!(problem.w[i] > 0)) continue;
+        const KnotPosition<Scalar> at =
+            knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
+        const SplineBasis<Scalar> basis = spline_basis(k, at.u);
+        for (int j = 0; j <= k; ++j) {
+          const std::size_t c = at.segment + std::size_t(j);
+          const Scalar mass = problem.w[i] * basis.ordinary[std::size_t(j)];
+          if (!(mass > 0)) continue;
+          const Tangent offset = G::log(G::compose(G::inverse(anchors[c]), observations[i]));
+          if (!offset.allFinite()) continue;
+          partial.force[c - partial.first] += mass * offset;
+          partial.mass[c - partial.first] += mass;
+        }
+      }
+    };
+    run_chunks(scratch, chunk_sum);
+    std::vector<Tangent> sums(knots.control_points, Tangent::Zero());
+    std::vector<Scalar> masses(knots.control_points, Scalar(0));
+    for (const ChunkPartial& partial : scratch.partials) {
+      for (std::size_t r = 0; r < partial.force.size(); ++r) {
+        sums[partial.first + r] += partial.force[r];
+        masses[partial.first + r] += partial.mass[r];
       }
     }
+    std::vector<Element> points = anchors;
     for (std::size_t c = 0; c < knots.control_points; ++c) {
       if (masses[c] > 0) points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
     }
     return points;
   }
 
+  // body(chunk) for every chunk, on the pool's threads when there is one.
+  template <class Body>
+  static void run_chunks(Scratch& scratch, const Body& body) {
+    if (scratch.pool) {
+      scratch.pool->run(scratch.partials.size(), body);
+    } else {
+      for (std::size_t chunk = 0; chunk < scratch.partials.size(); ++chunk)
+        body(chunk);
+    }
+  }
+
   // The residuals, F and sum |F|^2 at `points` into `evaluation`; K too
-  // when `jacobian`. `increments` and `jacobians` are scratch, sized once.
+  // when `jacobian`. Each chunk of observations (in covariate order, so
+  // that it touches a run of control points) sums into its own partial,
+  // and the partials are added in chunk order: the same arithmetic for any
+  // thread count.
   template <class Observations>
   void evaluate(const Observations& observations, const Problem<Scalar>& problem,
                 const Knots& knots, const std::vector<Element>& points,
                 std::vector<Tangent>& residuals, BlockBandedMatrix<AdMatrix, Tangent>* jacobian,
                 Scratch& scratch, Evaluation& evaluation) const {
     const int k = options_.degree;
+    const std::size_t band = 2 * std::size_t(k) + 1;
     std::vector<Tangent>& increments = scratch.increments;
     std::vector<IncrementJacobians<G>>& increment_jacobians = scratch.jacobians;
     std::fill(evaluation.force.begin(), evaluation.force.end(), Tangent::Zero());
     evaluation.merit = 0;
     evaluation.finite = true;
-    for (std::size_t j = 0; j < increments.size(); ++j) {
-      increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
-      if (!increments[j].allFinite()) {
+    // The increments and their Jacobians, by pieces of kIncrementChunk on
+    // the pool (each piece writes its own entries).
+    constexpr std::size_t kIncrementChunk = 1024;
+    const auto increment_piece = [&](std::size_t piece) {
+      const std::size_t end = std::min(increments.size(), (piece + 1) * kIncrementChunk);
+      for (std::size_t j = piece * kIncrementChunk; j < end; ++j) {
+        increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
+        increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
+      }
+    };
+    const std::size_t pieces = (increments.size() + kIncrementChunk - 1) / kIncrementChunk;
+    if (scratch.pool) {
+      scratch.pool->run(pieces, increment_piece);
+    } else {
+      for (std::size_t piece = 0; piece < pieces; ++piece)
+        increment_piece(piece);
+    }
+    for (const Tangent& increment : increments) {
+      if (!increment.allFinite()) {
         evaluation.finite = false;
         return;
       }
-      increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
     }
+    const auto chunk_sum = [&](std::size_t chunk) {
+      ChunkPartial& partial = scratch.partials[chunk];
+      std::fill(partial.force.begin(), partial.force.end(), Tangent::Zero());
+      if (jacobian) std::fill(partial.blocks.begin(), partial.blocks.end(), AdMatrix::Zero());
+      SegmentProduct<G> product;
+      ControlPointDifferentials<G> differentials;
+      for (std::size_t position = partial.begin; position < partial.end; ++position) {
+        const std::size_t i = scratch.order[position];
+        const KnotPosition<Scalar> at =
+            knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
+        const SplineBasis<Scalar> basis = spline_basis(k, at.u);
+        evaluate_segment<G>(k, &increments[at.segment], basis, product);
+        const Element curve = G::compose(points[at.segment], product.suffix[0]);
+        residuals[i] = G::log(G::compose(G::inverse(curve), observations[i]));
+        const Scalar w = problem.w[i];
+        if (!(w > 0)) continue;
+        control_point_differentials<G>(k, basis, product, &increment_jacobians[at.segment],
+                                       differentials);
+        const std::size_t row = at.segment - partial.first;  // of j = 0
+        for (int j = 0; j <= k; ++j)
+          partial.force[row + std::size_t(j)] += w * (differentials.weight[j] * residuals[i]);
+        if (!jacobian) continue;
+        // K_cl = -sum_i w_i W_c J_l(r_i)^{-1} D_l (splines.md §9).
+        const AdMatrix left_inverse = right_jacobian_inverse<G>((-residuals[i]).eval());
+        for (int j = 0; j <= k; ++j) {
+          const AdMatrix weighted = w * (differentials.weight[j] * left_inverse);
+          AdMatrix* blocks = &partial.blocks[(row + std::size_t(j)) * band];
+          for (int l = 0; l <= k; ++l)
+            blocks[std::size_t(l - j + k)].noalias() -= weighted * differentials.derivative[l];
+        }
+      }
+    };
+    run_chunks(scratch, chunk_sum);
     if (jacobian) jacobian->set_zero();
-    SegmentProduct<G> product;
-    ControlPointDifferentials<G> differentials;
-    for (std::size_t i = 0; i < problem.size(); ++i) {
-      const KnotPosition<Scalar> at =
-          knot_position(problem.t[i], Scalar(0), knots.h, knots.segments);
-      const SplineBasis<Scalar> basis = spline_basis(k, at.u);
-      evaluate_segment<G>(k, &increments[at.segment], basis, product);
-      const Element curve = G::compose(points[at.segment], product.suffix[0]);
-      residuals[i] = G::log(G::compose(G::inverse(curve), observations[i]));
-      const Scalar w = problem.w[i];
-      if (!(w > 0)) continue;
-      control_point_differentials<G>(k, basis, product, &increment_jacobians[at.segment],
-                                     differentials);
-      for (int j = 0; j <= k; ++j)
-        evaluation.force[at.segment + std::size_t(j)] +=
-            w * (differentials.weight[j] * residuals[i]);
-      if (!jacobian) continue;
-      // K_cl = -sum_i w_i W_c J_l(r_i)^{-1} D_l (splines.md §9).
-      const AdMatrix left_inverse = right_jacobian_inverse<G>((-residuals[i]).eval());
-      for (int j = 0; j <= k; ++j) {
-        const AdMatrix row = w * (differentials.weight[j] * left_inverse);
-        for (int l = 0; l <= k; ++l) {
-          (*jacobian)(at.segment + std::size_t(j), at.segment + std::size_t(l)).noalias() -=
-              row * differentials.derivative[l];
+    const std::size_t m = points.size();
+    for (const ChunkPartial& partial : scratch.partials) {
+      for (std::size_t r = 0; r < partial.force.size(); ++r) {
+        const std::size_t c = partial.first + r;
+        evaluation.force[c] += partial.force[r];
+        if (!jacobian) continue;
+        for (std::size_t o = 0; o < band; ++o) {
+          if (c + o < std::size_t(k) || c + o - std::size_t(k) >= m) continue;
+          (*jacobian)(c, c + o - std::size_t(k)) += partial.blocks[r * band + o];
         }
       }
     }
@@ -390,7 +497,12 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
     return rejected(*rejection);
   }
-  if (auto rejection = check_observations<G>(observations, options_.element_tolerance)) {
+  // The pool lives as long as this fit; below kParallelMinimum there is none.
+  std::optional<ChunkPool> pool;
+  if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads, chunk_count(n));
+  ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
+  if (auto rejection =
+          check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
     return rejected(*rejection);
   }
   Knots knots;
@@ -418,14 +530,14 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   }
 
   // 2. The start.
-  std::vector<Element> points = start ? *start : chart_start(observations, problem, order, knots);
+  Scratch scratch(problem, knots, std::move(order), options_.degree, chunk_pool);
+  std::vector<Element> points = start ? *start : chart_start(observations, problem, knots, scratch);
 
   // 3. Gauss-Newton with backtracking.
   Result result;
   result.residuals.resize(n);
   BlockBandedMatrix<AdMatrix, Tangent> jacobian(knots.control_points, std::size_t(options_.degree));
   BlockBandedMatrix<AdMatrix, Tangent> trial_jacobian = jacobian;
-  Scratch scratch(knots.control_points);
   Evaluation current(knots.control_points), next(knots.control_points);
   evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
   if (!current.finite) {
