@@ -205,6 +205,16 @@ TEST_CASE("bireg_smooth: bad usage gives exit 2 with the message and the usage",
       {"--group SO3 --bandwidth 1 --threads 0" + small, "--threads needs an integer in [1, 1024]"},
       {"--group SE2 --bandwidth 1 --output-format tum" + small,
        "the tum format holds SE3 or SO3 poses, not SE2"},
+      {"--group SO3 --method cubic" + small, "unknown method 'cubic' (local or spline)"},
+      {"--group SO3 --method spline --bandwidth 1" + small,
+       "--bandwidth applies to --method local only"},
+      {"--group SO3 --method spline --kernel tricube" + small,
+       "--kernel applies to --method local only"},
+      {"--group SO3 --degree 3" + small, "--degree applies to --method spline only"},
+      {"--group SO3 --knot-spacing 1" + small, "--knot-spacing applies to --method spline only"},
+      {"--group SO3 --method spline --degree 4" + small, "--degree needs 1, 2 or 3"},
+      {"--group SO3 --method spline --knot-spacing -1" + small,
+       "--knot-spacing needs a positive number or auto"},
   };
   for (const auto& [args, expected] : cases) {
     CAPTURE(args);
@@ -263,6 +273,56 @@ TEST_CASE("bireg_smooth: a noise-free SO3 geodesic is smoothed to its poses and 
       }
     }
   }
+}
+
+// A cubic spline reproduces a geodesic exactly (control points along it
+// give equal increments, whose exponentials commute, and the cumulative
+// basis sums to 1 + u: the product is the geodesic), so the fit's
+// residuals vanish there; what is left is the Gauss-Newton tolerance
+// (1e-10 on the control points) over the knot spacing of 0.5 s and the
+// 17-digit matrices: 1e-8 on poses and velocities.
+TEST_CASE("bireg_smooth --method spline: a noise-free SO3 geodesic, its velocity, and refusals",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.8, -0.4, 1.1), 60);
+  const std::string input = make_file("so3_geodesic_spline.csv", file.text);
+  const fs::path velocity = work_dir() / "so3_spline_velocity.csv";
+  const Run run = run_tool("--group SO3 --method spline --knot-spacing 0.5 --velocity \"" +
+                           velocity.string() + "\" " + input);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  const std::vector<Line> poses = parse_csv(run.out);
+  REQUIRE(poses.size() == 60);
+  const std::string text = slurp(velocity);
+  const std::string header = split(text, '\n').at(0);
+  REQUIRE(header == "t,wx,wy,wz,se_wx,se_wy,se_wz,status");
+  const std::vector<Line> rows = parse_csv(text.substr(header.size() + 1));
+  REQUIRE(rows.size() == 60);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    REQUIRE((element_of<G>(poses[k].numbers) - file.at(static_cast<double>(k) / 10.0)).norm() <
+            1e-8);
+    REQUIRE(rows[k].status == "ok");
+    for (int i = 0; i < 3; ++i)
+      REQUIRE(std::abs(rows[k].numbers[static_cast<std::size_t>(i)] - file.velocity[i]) < 1e-8);
+  }
+
+  // auto: the choice on stderr, the curve in --cv-table.
+  const fs::path table = work_dir() / "so3_spline_cv.csv";
+  const Run chosen =
+      run_tool("--group SO3 --method spline --cv-table \"" + table.string() + "\" " + input);
+  CAPTURE(chosen.err);
+  REQUIRE(chosen.exit_code == 0);
+  REQUIRE(chosen.err.find("bireg_smooth: knot spacing auto: ") == 0);
+  const std::vector<std::string> curve = split(slurp(table), '\n');
+  REQUIRE(curve.at(0) == "knot_spacing,criterion,failures,refused");
+  REQUIRE(curve.size() >= 25);  // the header and 24 spacings
+
+  // Knots the data cannot determine: invalid input, named.
+  const Run dense = run_tool("--group SO3 --method spline --knot-spacing 0.01 " + input);
+  REQUIRE(dense.exit_code == 2);
+  REQUIRE(dense.err.find("control points for 60 observations; use a wider spacing") !=
+          std::string::npos);
 }
 
 TEST_CASE("bireg_smooth: SE3 velocity columns are translation first, as the group's tangent",

@@ -1,9 +1,11 @@
 // bireg_smooth: pose and body velocity along a whole trajectory by
-// kernel-weighted local geodesic regression (bireg/statistics/smoothing/local_regression.hpp).
+// kernel-weighted local geodesic regression (bireg/statistics/smoothing/local_regression.hpp)
+// or by one bi-invariant spline (bireg/spline_regression.hpp).
 //
 //   bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]
 //                [--times FILE] [--project]
 //                [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]
+//                [--method local|spline] [--degree 1|2|3] [--knot-spacing S|auto]
 //                [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]
 //                [--output FILE] [--output-format matrix|tum|euroc|kitti]
 //                [--threads N] [--progress] FILE|-
@@ -38,6 +40,19 @@
 //   --rate HZ  at first + k / HZ for k = 0, 1, ... up to the last timestamp,
 //              each rounded to the nanosecond and computed exactly from the
 //              first timestamp's decimal digits (no drift at 1.7e9 s).
+//
+// --method spline fits one cumulative B-spline of --degree (default 3) to
+// the whole trajectory instead (SplineRegression) with uniform knots at
+// most S seconds apart; "auto" (the default) chooses S by cross-validation
+// (select_knot_spacing over auto_knot_spacing_grid: 24 values from 1.25
+// median sample spacings to the whole range, 5 folds), printed on stderr,
+// and --cv-table FILE writes its curve (CSV: knot_spacing, criterion,
+// failures, refused). Poses and velocities are the spline's at the queries;
+// the velocity's standard errors are not computed yet (empty fields). A
+// knot spacing the data cannot determine is invalid input (exit 2); a fit
+// that fails marks every row failed (exit 3). --bandwidth and --kernel
+// apply to the local method only, --degree and --knot-spacing to the
+// spline only: the other method's options are refused.
 //
 // --threads N (default: every core) shares the queries, and the
 // cross-validation of --bandwidth auto, out to N threads in blocks of 1024
@@ -74,7 +89,9 @@
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
+#include "bireg/spline_regression.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
@@ -90,6 +107,7 @@ constexpr const char* kUsage =
     "usage: bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]\n"
     "                    [--times FILE] [--project]\n"
     "                    [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]\n"
+    "                    [--method local|spline] [--degree 1|2|3] [--knot-spacing S|auto]\n"
     "                    [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]\n"
     "                    [--output FILE] [--output-format matrix|tum|euroc|kitti]\n"
     "                    [--threads N] [--progress] FILE|-\n"
@@ -97,7 +115,8 @@ constexpr const char* kUsage =
 
 constexpr const char* kHelp =
     "Pose and body velocity along a trajectory by kernel-weighted local geodesic\n"
-    "regression (bireg/statistics/smoothing/local_regression.hpp).\n"
+    "regression (bireg/statistics/smoothing/local_regression.hpp), or by one\n"
+    "bi-invariant spline (bireg/spline_regression.hpp) with --method spline.\n"
     "\n"
     "  --group G          SO2, SO3, SE2 or SE3 (required)\n"
     "  --format F         input format: matrix, tum, euroc or kitti (default: detected)\n"
@@ -108,12 +127,19 @@ constexpr const char* kHelp =
     "                     median sample spacing to the whole range, one choice for the\n"
     "                     poses and one for the velocity, printed on stderr\n"
     "  --kernel K         gaussian (default; truncated at 4 H), epanechnikov or tricube\n"
+    "  --method M         local (default): local regression at every query; spline: one\n"
+    "                     cumulative B-spline through the whole trajectory\n"
+    "  --degree K         the spline's degree, 1, 2 or 3 (default 3)\n"
+    "  --knot-spacing S|auto  the spline's largest knot spacing in seconds; auto\n"
+    "                     (default): cross-validation over 24 values from 1.25 median\n"
+    "                     sample spacings to the whole range, printed on stderr\n"
     "  --at FILE          evaluate at the timestamps in FILE (one per line) instead of\n"
     "                     at every input timestamp\n"
     "  --rate HZ          evaluate at first + k / HZ up to the last timestamp\n"
     "  --velocity FILE    write the body velocity (rad/s; m/s for translations) with\n"
-    "                     its standard errors and a status per row, as CSV\n"
-    "  --cv-table FILE    write the cross-validation curves of --bandwidth auto as CSV\n"
+    "                     its standard errors (local method) and a status per row, as CSV\n"
+    "  --cv-table FILE    write the cross-validation curves of --bandwidth auto (or of\n"
+    "                     --knot-spacing auto) as CSV\n"
     "  --output FILE      the smoothed poses (default: standard output)\n"
     "  --output-format F  their format (default: the input's)\n"
     "  --threads N        threads, 1 to 1024 (default: every core); the output does not\n"
@@ -135,6 +161,12 @@ struct Command {
   bireg_cli::InputOptions input;
   std::optional<double> bandwidth;  // empty: auto
   bireg::Kernel kernel = bireg::Kernel::gaussian;
+  bool spline = false;                 // --method spline
+  int degree = 3;                      // the spline's
+  std::optional<double> knot_spacing;  // empty: auto
+  // Options given that belong to one method only, for the refusal of the
+  // other's.
+  std::vector<std::string> local_options, spline_options;
   std::string at;
   std::optional<double> rate;
   std::string velocity;
@@ -188,7 +220,25 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       }
     } else if (arg == "--times") {
       command.input.times = v;
+    } else if (arg == "--method") {
+      if (v != "local" && v != "spline") return "unknown method '" + v + "' (local or spline)";
+      command.spline = v == "spline";
+    } else if (arg == "--degree") {
+      command.spline_options.push_back(arg);
+      if (v != "1" && v != "2" && v != "3") return "--degree needs 1, 2 or 3";
+      command.degree = v[0] - '0';
+    } else if (arg == "--knot-spacing") {
+      command.spline_options.push_back(arg);
+      double h = 0;
+      if (v == "auto") {
+        command.knot_spacing.reset();
+      } else if (!parse_number(v, h) || !(h > 0)) {
+        return "--knot-spacing needs a positive number or auto";
+      } else {
+        command.knot_spacing = h;
+      }
     } else if (arg == "--bandwidth") {
+      command.local_options.push_back(arg);
       double h = 0;
       if (v == "auto") {
         command.bandwidth.reset();
@@ -198,6 +248,7 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
         command.bandwidth = h;
       }
     } else if (arg == "--kernel") {
+      command.local_options.push_back(arg);
       bool known = false;
       for (bireg::Kernel kernel :
            {bireg::Kernel::gaussian, bireg::Kernel::epanechnikov, bireg::Kernel::tricube}) {
@@ -226,6 +277,12 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
     }
   }
   if (command.group.empty()) return "--group is required";
+  if (command.spline && !command.local_options.empty()) {
+    return command.local_options.front() + " applies to --method local only";
+  }
+  if (!command.spline && !command.spline_options.empty()) {
+    return command.spline_options.front() + " applies to --method spline only";
+  }
   if (!command.at.empty() && command.rate) return "--at and --rate exclude each other";
   if (command.at == "-" && command.input.path == "-") {
     return "--at and the input cannot both be standard input";
@@ -333,6 +390,138 @@ std::optional<std::string> write_cv_table(const std::string& path,
   return bireg_cli::write_text_file(path, text);
 }
 
+// The local method: poses at the pose bandwidth and, when --velocity asks
+// and the velocity's bandwidth differs, velocities at their own. Returns an
+// exit code when it cannot go on.
+template <class G>
+std::optional<int> local_estimates(const Command& command, const std::string& name,
+                                   const bireg::io::Trajectory<G>& trajectory,
+                                   const std::vector<double>& queries,
+                                   std::vector<bireg::LocalEstimate<G>>& estimates,
+                                   std::vector<bireg::LocalEstimate<G>>& velocity_estimates) {
+  namespace io = bireg::io;
+  bireg::LocalRegressionOptions<double> options;
+  options.kernel = command.kernel;
+  options.threads = command.threads;
+  double velocity_bandwidth = 0;
+  if (command.bandwidth) {
+    options.bandwidth = *command.bandwidth;
+    velocity_bandwidth = options.bandwidth;
+  } else {
+    const std::vector<double> grid = bireg::auto_bandwidth_grid(trajectory.covariates);
+    bireg_cli::Progress progress("bireg_smooth", command.progress);
+    const bireg::BandwidthSelection<double> selection =
+        bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid,
+                                   [&](std::size_t done, std::size_t total) {
+                                     progress.update("bandwidth auto", done, total);
+                                   });
+    progress.finish();
+    if (!command.cv_table.empty()) {
+      if (auto error = write_cv_table(command.cv_table, selection)) {
+        std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
+        return kExitWriteError;
+      }
+    }
+    if (!selection.ok()) {
+      return fail(name + ": bandwidth auto: " + selection.message + ": give --bandwidth H");
+    }
+    options.bandwidth = selection.bandwidth;
+    velocity_bandwidth = selection.velocity_bandwidth;
+    std::fprintf(stderr,
+                 "bireg_smooth: bandwidth auto: %s s for the poses, %s s for the velocity "
+                 "(cross-validation over %zu values from %s to %s s)\n",
+                 io::json_number(selection.bandwidth).c_str(),
+                 io::json_number(selection.velocity_bandwidth).c_str(), grid.size(),
+                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
+    if (!selection.message.empty()) {
+      std::fprintf(stderr, "bireg_smooth: warning: bandwidth auto: %s\n",
+                   selection.message.c_str());
+    }
+  }
+  estimates = bireg::LocalGeodesicRegression<G>(options).smooth_at(trajectory.observations,
+                                                                   trajectory.covariates, queries);
+  if (!command.velocity.empty() && velocity_bandwidth != options.bandwidth) {
+    bireg::LocalRegressionOptions<double> velocity_options = options;
+    velocity_options.bandwidth = velocity_bandwidth;
+    velocity_estimates = bireg::LocalGeodesicRegression<G>(velocity_options)
+                             .smooth_at(trajectory.observations, trajectory.covariates, queries);
+  }
+  return std::nullopt;
+}
+
+// The cross-validation curve of --knot-spacing auto, one row per spacing:
+// its criterion (empty where refused), failed fits, and why it was refused.
+template <class Scalar>
+std::optional<std::string> write_knot_table(const std::string& path,
+                                            const bireg::KnotSpacingSelection<Scalar>& selection) {
+  std::string text = "knot_spacing,criterion,failures,refused\n";
+  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
+    bireg::io::append_double(text, selection.grid[k]);
+    text += ',';
+    if (std::isfinite(selection.criterion[k])) {
+      bireg::io::append_double(text, selection.criterion[k]);
+    }
+    text += ',' + std::to_string(selection.failures[k]) + ',' +
+            bireg_cli::csv_field(selection.refusals[k]) + '\n';
+  }
+  return bireg_cli::write_text_file(path, text);
+}
+
+// --method spline: one fit, every query's pose and velocity read off it (as
+// LocalEstimate rows, so that the output is written as the local method's).
+// Returns an exit code when it cannot go on.
+template <class G>
+std::optional<int> spline_estimates(const Command& command, const std::string& name,
+                                    const bireg::io::Trajectory<G>& trajectory,
+                                    const std::vector<double>& queries,
+                                    std::vector<bireg::LocalEstimate<G>>& estimates) {
+  namespace io = bireg::io;
+  bireg::SplineOptions<double> options;
+  options.degree = command.degree;
+  options.threads = command.threads;
+  if (command.knot_spacing) {
+    options.knot_spacing = *command.knot_spacing;
+  } else {
+    const std::vector<double> grid = bireg::auto_knot_spacing_grid(trajectory.covariates);
+    const bireg::KnotSpacingSelection<double> selection = bireg::select_knot_spacing<G>(
+        trajectory.observations, trajectory.covariates, options, grid);
+    if (!command.cv_table.empty()) {
+      if (auto error = write_knot_table(command.cv_table, selection)) {
+        std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
+        return kExitWriteError;
+      }
+    }
+    if (!selection.ok()) {
+      return fail(name + ": knot spacing auto: " + selection.message + ": give --knot-spacing S");
+    }
+    options.knot_spacing = selection.knot_spacing;
+    std::fprintf(stderr,
+                 "bireg_smooth: knot spacing auto: %s s (cross-validation over %zu values from "
+                 "%s to %s s)\n",
+                 io::json_number(selection.knot_spacing).c_str(), grid.size(),
+                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
+    if (!selection.message.empty()) {
+      std::fprintf(stderr, "bireg_smooth: warning: knot spacing auto: %s\n",
+                   selection.message.c_str());
+    }
+  }
+  const bireg::SplineResult<G> fit =
+      bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
+  if (fit.status == bireg::Status::invalid_input) return fail(name + ": " + fit.message);
+  estimates.resize(queries.size());
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    bireg::LocalEstimate<G>& e = estimates[q];
+    e.covariate = queries[q];
+    e.status = fit.status;
+    e.message = fit.message;
+    e.iterations = fit.iterations;
+    e.window = trajectory.observations.size();
+    e.pose = (*fit.spline)(queries[q]);
+    e.velocity = fit.spline->body_velocity(queries[q]);
+  }
+  return std::nullopt;
+}
+
 // One line on stderr per failed query, the first kFailuresShown of them.
 constexpr std::size_t kFailuresShown = 10;
 
@@ -397,54 +586,12 @@ int run(const Command& command) {
       query_places.push_back(bireg_cli::where(name, line));
   }
 
-  bireg::LocalRegressionOptions<double> options;
-  options.kernel = command.kernel;
-  options.threads = command.threads;
-  double velocity_bandwidth = 0;
-  if (command.bandwidth) {
-    options.bandwidth = *command.bandwidth;
-    velocity_bandwidth = options.bandwidth;
-  } else {
-    const std::vector<double> grid = bireg::auto_bandwidth_grid(trajectory.covariates);
-    bireg_cli::Progress progress("bireg_smooth", command.progress);
-    const bireg::BandwidthSelection<double> selection =
-        bireg::select_bandwidth<G>(trajectory.observations, trajectory.covariates, options, grid,
-                                   [&](std::size_t done, std::size_t total) {
-                                     progress.update("bandwidth auto", done, total);
-                                   });
-    progress.finish();
-    if (!command.cv_table.empty()) {
-      if (auto error = write_cv_table(command.cv_table, selection)) {
-        std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
-        return kExitWriteError;
-      }
-    }
-    if (!selection.ok()) {
-      return fail(name + ": bandwidth auto: " + selection.message + ": give --bandwidth H");
-    }
-    options.bandwidth = selection.bandwidth;
-    velocity_bandwidth = selection.velocity_bandwidth;
-    std::fprintf(stderr,
-                 "bireg_smooth: bandwidth auto: %s s for the poses, %s s for the velocity "
-                 "(cross-validation over %zu values from %s to %s s)\n",
-                 io::json_number(selection.bandwidth).c_str(),
-                 io::json_number(selection.velocity_bandwidth).c_str(), grid.size(),
-                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
-    if (!selection.message.empty()) {
-      std::fprintf(stderr, "bireg_smooth: warning: bandwidth auto: %s\n",
-                   selection.message.c_str());
-    }
-  }
-  const std::vector<bireg::LocalEstimate<G>> estimates =
-      bireg::LocalGeodesicRegression<G>(options).smooth_at(trajectory.observations,
-                                                           trajectory.covariates, queries);
-  std::vector<bireg::LocalEstimate<G>> velocity_estimates;
-  if (!command.velocity.empty() && velocity_bandwidth != options.bandwidth) {
-    bireg::LocalRegressionOptions<double> velocity_options = options;
-    velocity_options.bandwidth = velocity_bandwidth;
-    velocity_estimates = bireg::LocalGeodesicRegression<G>(velocity_options)
-                             .smooth_at(trajectory.observations, trajectory.covariates, queries);
-  }
+  std::vector<bireg::LocalEstimate<G>> estimates, velocity_estimates;
+  const std::optional<int> stopped =
+      command.spline
+          ? spline_estimates<G>(command, name, trajectory, queries, estimates)
+          : local_estimates<G>(command, name, trajectory, queries, estimates, velocity_estimates);
+  if (stopped) return *stopped;
   const std::vector<bireg::LocalEstimate<G>>& velocities =
       velocity_estimates.empty() ? estimates : velocity_estimates;
 

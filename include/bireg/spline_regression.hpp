@@ -229,11 +229,15 @@ class SplineRegression {
     const Wide segments =
         std::max(Wide(1), ceil(ratio * (1 - 8 * std::numeric_limits<Wide>::epsilon())));
     if (!(segments + Wide(k) <= Wide(n))) {
-      return Rejection{
-          "knot spacing " + std::to_string(double(options_.knot_spacing)) + " cuts the range " +
-          std::to_string(double(range)) + " into " + std::to_string(double(segments)) +
-          " segments: " + std::to_string(double(segments + Wide(k))) + " control points for " +
-          std::to_string(n) + " observations; use a wider spacing"};
+      const auto count = [](Wide x) {  // a whole number, as one
+        return x < Wide(1e18) ? std::to_string(static_cast<unsigned long long>(x))
+                              : std::to_string(double(x));
+      };
+      return Rejection{"knot spacing " + std::to_string(double(options_.knot_spacing)) +
+                       " cuts the range " + std::to_string(double(range)) + " into " +
+                       count(segments) + " segments: " + count(segments + Wide(k)) +
+                       " control points for " + std::to_string(n) +
+                       " observations; use a wider spacing"};
     }
     knots.segments = static_cast<std::size_t>(segments);
     knots.control_points = knots.segments + k;

@@ -70,6 +70,8 @@ void control_point_differentials(int degree, const SplineBasis<typename G::Scala
   const int k = degree;
   // E_j, and J_r(b_k Omega_k)^{-1} for W_k.
   std::array<AdMatrix, kMaxSplineDegree + 1> e;
+  for (AdMatrix& block : e)
+    block.setZero();  // e[0] is unused; GCC cannot tell that the rest are set
   AdMatrix last_inverse = AdMatrix::Identity();
   for (int j = 1; j <= k; ++j) {
     const Tangent scaled = basis.cumulative[j] * product.omega[j];
