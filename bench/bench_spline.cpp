@@ -16,42 +16,25 @@
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/spline_regression.hpp"
-#include "bireg/testing/random.hpp"
+#include "smooth_curve.hpp"
 
 namespace {
 
 using G = bireg::SO3d;
 
-struct Data {
-  std::vector<G::Element> f;
-  std::vector<double> t;
-};
-
-constexpr double kSpacing = 1e-3;  // s: 1 kHz
+using Data = bench::SmoothCurve;
+using bench::kSpacing;
 
 Data curve(int n) {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> normal(0.0, 0.01);
-  const double w = 2 * M_PI / 10;
-  Data data;
-  for (int i = 0; i < n; ++i) {
-    const double t = i * kSpacing;
-    const G::Tangent c =
-        0.5 * G::Tangent(std::sin(w * t), std::cos(w * t) - 1, std::sin(2 * w * t));
-    const G::Tangent e = bireg::testing::draw_vector<G::Tangent>(rng, normal);
-    data.t.push_back(t);
-    data.f.push_back(G::compose(G::exp(c), G::exp(e)));
-  }
-  return data;
+  return bench::smooth_curve(n);
 }
 
 // Counters shared by both fits: Gauss-Newton steps proposed (the last
 // certifies), and the time per observation and step.
 void count(benchmark::State& state, double n, int iterations) {
   state.counters["iterations"] = iterations;
-  state.counters["per_observation_iteration"] =
-      benchmark::Counter(n * iterations, benchmark::Counter::kIsIterationInvariantRate |
-                                             benchmark::Counter::kInvert);
+  state.counters["per_observation_iteration"] = benchmark::Counter(
+      n * iterations, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 // Args: N, threads.

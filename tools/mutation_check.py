@@ -173,6 +173,21 @@ MUTANTS = [
            "std::min(result.relabelling_maximum[r], slice.relabelling_maximum[r]);",
            ["test_cohort_maps"],
            "joined slices keep the smallest maximum: family-wise p-values too small"),
+    Mutant("SP1", "include/bireg/regression/spline/differentials.hpp",
+           "b[0] * (first.left * right_jacobian_inverse<G>(anchor_scaled)) * G::Ad(product.suffix[1]);",
+           "b[0] * (first.right * right_jacobian_inverse<G>(anchor_scaled)) * G::Ad(product.suffix[1]);",
+           ["test_spline"],
+           "the anchor's closed-form weight with J_r(Omega_1) for J_l(Omega_1)"),
+    Mutant("SP2", "include/bireg/spline_regression.hpp",
+           "partial.force[row + std::size_t(j)] += w * (differentials.weight[j] * residuals[i]);",
+           "partial.force[row + std::size_t(j)] += differentials.weight[j] * residuals[i];",
+           ["test_spline"],
+           "weights dropped from the spline's estimating equations"),
+    Mutant("SP3", "include/bireg/spline_regression.hpp",
+           "blocks[std::size_t(l - j + k)].noalias() -= weighted * differentials.derivative[l];",
+           "blocks[std::size_t(l - j + k)].noalias() -= weighted;",
+           ["test_spline"],
+           "the Gauss-Newton matrix without D_l (B_c B_l H kron I only at the identity)"),
 ]
 
 

@@ -16,6 +16,8 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/spline.hpp"
+#include "bireg/spline_regression.hpp"
 #include "bireg/statistics/cohorts/elementwise.hpp"
 #include "bireg/statistics/cohorts/trends.hpp"
 #include "bireg/statistics/cohorts/two_sample.hpp"
@@ -31,3 +33,4 @@
 #include "bireg/statistics/robust/regression.hpp"
 #include "bireg/statistics/selection/model_selection.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
