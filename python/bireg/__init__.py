@@ -1,8 +1,8 @@
 """bireg: bi-invariant geodesic regression on Lie groups.
 
 A Python face for the header-only C++ library of the same name: the
-groups with vectorised operations, ``GeodesicRegression`` and
-``LocalRegression`` in scikit-learn's style, the bi-invariant ``mean``,
+groups with vectorised operations, ``GeodesicRegression``,
+``LocalRegression`` and ``SplineRegression`` in scikit-learn's style, the bi-invariant ``mean``,
 the two-sample tests of cohorts and their trends, and the trajectory
 readers; ``bireg.dask`` (imported on its own, with the ``dask`` extra)
 runs the cohorts on a Dask cluster. The README maps each name to its C++
@@ -17,10 +17,11 @@ from .groups import GLp3, SE2, SE3, SL3, SO2, SO3, Group, Sim3
 from .io import read_trajectory
 from .local import LocalRegression
 from .regression import ConvergenceWarning, GeodesicRegression, mean
+from .spline import SplineRegression
 
 __all__ = [
     "__version__", "Group", "SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3",
-    "GeodesicRegression", "LocalRegression", "ConvergenceWarning", "mean", "read_trajectory",
+    "GeodesicRegression", "LocalRegression", "SplineRegression", "ConvergenceWarning", "mean", "read_trajectory",
     "two_sample_test", "TwoSampleResult", "ElementwiseResult", "fit_many", "FitManyResult",
     "compare_trends", "compare_trends_at", "compare_velocities", "population_trend",
     "PopulationTrend",

@@ -87,6 +87,14 @@ def fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), ord
     bireg::GeodesicRegression<G>::fit (or RobustGeodesicRegression with a loss) of y at t with weights (empty: all 1). ValueError for invalid input.
     """
 
+def spline_fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], degree: int, knot_spacing: float, tol: float, max_iter: int, threads: int) -> dict:
+    """
+    bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing).
+    """
+
+def spline_evaluate(group: str, degree: int, first_knot: float, spacing: float, control_points: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]) -> dict:
+    """bireg::Spline<G>: pose, body velocity and acceleration at t."""
+
 def mean(group: str, y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], tol: float, max_iter: int) -> dict:
     """bireg::mean<G>: a dict with the mean, status, iterations, residuals."""
 

@@ -210,6 +210,7 @@ Output tangent_rows(const std::vector<typename G::Tangent>& rows) {
 
 void bind_groups(nb::module_& m);
 void bind_regression(nb::module_& m);
+void bind_spline(nb::module_& m);
 void bind_statistics(nb::module_& m);
 void bind_io(nb::module_& m);
 void bind_cohorts(nb::module_& m);

@@ -1,5 +1,6 @@
 // The compiled part of the Python package bireg: one binding file per
-// layer of the library (groups, regression, statistics, io, cohorts). The Python
+// layer of the library (groups, regression with the spline beside it,
+// statistics, io, cohorts). The Python
 // modules in python/bireg/ give it its scikit-learn-style face.
 #include "common.hpp"
 
@@ -10,6 +11,7 @@ NB_MODULE(_bireg, m) {
   m.attr("__version__") = bireg::version;
   bireg_python::bind_groups(m);
   bireg_python::bind_regression(m);
+  bireg_python::bind_spline(m);
   bireg_python::bind_statistics(m);
   bireg_python::bind_io(m);
   bireg_python::bind_cohorts(m);

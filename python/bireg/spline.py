@@ -1,0 +1,101 @@
+"""Bi-invariant spline regression: one cumulative B-spline through a whole
+trajectory (bireg::SplineRegression, include/bireg/spline_regression.hpp;
+the derivation in docs/splines.md), scikit-learn style.
+"""
+
+import warnings
+
+import numpy as np
+
+from . import _arrays, _bireg
+from . import groups as _groups
+from .regression import ConvergenceWarning
+
+_SUCCESS = ("converged", "rounding_floor")
+
+
+class SplineRegression:
+    """``degree`` 1 (piecewise geodesic), 2 or 3; ``knot_spacing`` the largest
+    spacing of the uniform knots in covariate units, or ``"auto"``: chosen
+    by cross-validation (``bireg::select_knot_spacing`` over
+    ``auto_knot_spacing_grid``), its curve in ``knot_selection_``. ``tol``
+    and ``max_iter`` of the Gauss-Newton iteration; ``threads`` for its
+    passes (results do not depend on it).
+
+    Attributes set by ``fit``: ``control_points_`` (M, n, n),
+    ``first_knot_``, ``knot_spacing_`` (the spacing used: the range cut into
+    equal segments no longer than asked), ``status_``, ``n_iter_``,
+    ``equation_norm_``, ``residuals_`` (N, d), ``knot_selection_`` (a dict
+    for "auto", else None).
+    """
+
+    def __init__(self, group="SE3", degree=3, knot_spacing="auto", tol=1e-10, max_iter=100,
+                 threads=1):
+        self.group = group
+        self.degree = degree
+        self.knot_spacing = knot_spacing
+        self.tol = tol
+        self.max_iter = max_iter
+        self.threads = threads
+
+    def fit(self, t, Y, sample_weight=None):
+        """Fits the spline to Y[i] at t[i]; returns self. ValueError for
+        invalid input (a knot spacing the data cannot determine names the
+        control point and its span); a fit that does not converge sets
+        ``status_`` and warns with ConvergenceWarning."""
+        group = _groups.get(self.group)
+        t = _arrays.covariates(t)
+        Y = _arrays.matrices(Y, group.matrix_size)
+        if t.shape[0] != Y.shape[0]:
+            raise ValueError(f"t and Y differ in length ({t.shape[0]} vs {Y.shape[0]})")
+        w = _arrays.weights(sample_weight, t.shape[0])
+        degree = _arrays.positive_int(self.degree, "degree")
+        if isinstance(self.knot_spacing, str):
+            if self.knot_spacing != "auto":
+                raise ValueError(
+                    f"knot_spacing must be 'auto' or a number, got {self.knot_spacing!r}")
+            spacing = 0.0
+        else:
+            spacing = float(self.knot_spacing)
+            if not spacing > 0:
+                raise ValueError("knot_spacing must be a positive number (inf: one segment) or "
+                                 f"'auto', got {self.knot_spacing!r}")
+        out = _bireg.spline_fit(group.name, t, Y, w, degree, spacing, float(self.tol),
+                                _arrays.positive_int(self.max_iter, "max_iter"),
+                                _arrays.positive_int(self.threads, "threads"))
+        self.control_points_ = out["control_points"]
+        self.first_knot_ = out["first_knot"]
+        self.knot_spacing_ = out["knot_spacing"]
+        self.status_ = out["status"]
+        self.n_iter_ = out["iterations"]
+        self.equation_norm_ = out["equation_norm"]
+        self.residuals_ = out["residuals"]
+        self.knot_selection_ = out.get("knot_selection")
+        self._group, self._degree = group, degree
+        if self.knot_selection_ is not None and self.knot_selection_["message"]:
+            warnings.warn(f"knot spacing auto: {self.knot_selection_['message']}", UserWarning,
+                          stacklevel=2)
+        if self.status_ not in _SUCCESS:
+            warnings.warn(f"the spline fit ended {self.status_}: {out['message']}",
+                          ConvergenceWarning, stacklevel=2)
+        return self
+
+    def _evaluate(self, t_new):
+        if not hasattr(self, "control_points_"):
+            raise ValueError("this SplineRegression is not fitted yet: call fit(t, Y) first")
+        return _bireg.spline_evaluate(self._group.name, self._degree, self.first_knot_,
+                                      self.knot_spacing_, self.control_points_,
+                                      _arrays.covariates(t_new))
+
+    def predict(self, t_new):
+        """The curve at each covariate: (M,) -> (M, n, n). A covariate beyond
+        the knots is evaluated at the nearer end."""
+        return self._evaluate(t_new)["pose"]
+
+    def velocity(self, t_new):
+        """Body velocity T^{-1} dT/dt per covariate unit: (M,) -> (M, d)."""
+        return self._evaluate(t_new)["velocity"]
+
+    def acceleration(self, t_new):
+        """Body acceleration d/dt (T^{-1} dT/dt): (M,) -> (M, d)."""
+        return self._evaluate(t_new)["acceleration"]

@@ -1,0 +1,137 @@
+// The regression layer's spline (bireg/spline_regression.hpp): the fit, with
+// the knot spacing by cross-validation when asked, and the curve's pose,
+// body velocity and acceleration at new covariates. The GIL is released
+// while the library works.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "bireg/spline_regression.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
+#include "common.hpp"
+
+namespace bireg_python {
+namespace {
+
+template <class G>
+Output element_stack(const std::vector<typename G::Element>& elements) {
+  const std::size_t n = std::size_t(side<G>());
+  NewArray stack({elements.size(), n, n});
+  for (std::size_t c = 0; c < elements.size(); ++c)
+    write_row_major(elements[c], stack.data() + c * n * n);
+  return stack.release();
+}
+
+// knot_spacing <= 0: chosen by select_knot_spacing over
+// auto_knot_spacing_grid, the curve returned under "knot_selection".
+template <class G>
+nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree,
+                    double knot_spacing, double tolerance, int max_iterations, int threads) {
+  const StackView<G> poses(y);
+  const std::vector<double> covariates = to_vector(t), weights = to_vector(w);
+  bireg::SplineOptions<double> options;
+  options.degree = degree;
+  options.tolerance = tolerance;
+  options.max_iterations = max_iterations;
+  options.threads = threads;
+  nb::dict out;
+  bireg::SplineResult<G> fit;
+  bireg::KnotSpacingSelection<double> selection;
+  const bool automatic = !(knot_spacing > 0);
+  {
+    nb::gil_scoped_release release;
+    if (automatic) {
+      selection = bireg::select_knot_spacing<G>(poses, covariates, options,
+                                                bireg::auto_knot_spacing_grid(covariates));
+      options.knot_spacing = selection.knot_spacing;
+    } else {
+      options.knot_spacing = knot_spacing;
+    }
+    if (!automatic || selection.ok())
+      fit = bireg::SplineRegression<G>(options).fit(poses, covariates, weights);
+  }
+  if (automatic) {
+    if (!selection.ok()) refuse("knot spacing auto: " + selection.message);
+    nb::dict knots;
+    knots["knot_spacing"] = selection.knot_spacing;
+    knots["grid"] = vector_array(selection.grid);
+    knots["criterion"] = vector_array(selection.criterion);
+    nb::list refusals;
+    for (const std::string& r : selection.refusals)
+      refusals.append(r);
+    knots["refusals"] = refusals;
+    knots["message"] = selection.message;
+    out["knot_selection"] = knots;
+  }
+  if (fit.status == bireg::Status::invalid_input) refuse(fit.message);
+  out["status"] = std::string(to_string(fit.status));
+  out["message"] = fit.message;
+  out["iterations"] = fit.iterations;
+  out["equation_norm"] = fit.equation_norm;
+  out["first_knot"] = fit.spline->first_knot();
+  out["knot_spacing"] = fit.spline->knot_spacing();
+  out["control_points"] = element_stack<G>(fit.spline->control_points());
+  out["residuals"] = tangent_rows<G>(fit.residuals);
+  return out;
+}
+
+// The curve of control points `points` at t: pose, body velocity and body
+// acceleration (per covariate unit).
+template <class G>
+nb::dict evaluate_spline(int degree, double first_knot, double spacing, const Stack& points,
+                         const Vector& t) {
+  if (degree < 1 || degree > bireg::kMaxSplineDegree) refuse("degree must be 1, 2 or 3");
+  if (!(spacing > 0) || !std::isfinite(first_knot)) refuse("the knots must be finite, spacing > 0");
+  if (points.shape(0) <= std::size_t(degree)) refuse("too few control points for the degree");
+  check_covariates(t, "spline");
+  const StackView<G> view(points);
+  std::vector<typename G::Element> elements;
+  for (std::size_t c = 0; c < view.size(); ++c)
+    elements.push_back(view[c]);
+  const bireg::Spline<G> curve(degree, first_knot, spacing, std::move(elements));
+  const std::size_t count = t.shape(0), n = std::size_t(side<G>());
+  NewArray pose({count, n, n});
+  std::vector<typename G::Tangent> velocity(count), acceleration(count);
+  for (std::size_t q = 0; q < count; ++q) {
+    const double at = t.data()[q];
+    write_row_major(curve(at), pose.data() + q * n * n);
+    velocity[q] = curve.body_velocity(at);
+    acceleration[q] = curve.body_acceleration(at);
+  }
+  nb::dict out;
+  out["pose"] = pose.release();
+  out["velocity"] = tangent_rows<G>(velocity);
+  out["acceleration"] = tangent_rows<G>(acceleration);
+  return out;
+}
+
+}  // namespace
+
+void bind_spline(nb::module_& m) {
+  m.def(
+      "spline_fit",
+      [](const std::string& group, const Vector& t, const Stack& y, const Vector& w, int degree,
+         double knot_spacing, double tolerance, int max_iterations, int threads) {
+        return with_group(group, [&](auto tag) {
+          return fit_spline<typename decltype(tag)::type>(t, y, w, degree, knot_spacing, tolerance,
+                                                          max_iterations, threads);
+        });
+      },
+      nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("weights"), nb::arg("degree"),
+      nb::arg("knot_spacing"), nb::arg("tol"), nb::arg("max_iter"), nb::arg("threads"),
+      "bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing).");
+  m.def(
+      "spline_evaluate",
+      [](const std::string& group, int degree, double first_knot, double spacing,
+         const Stack& points, const Vector& t) {
+        return with_group(group, [&](auto tag) {
+          return evaluate_spline<typename decltype(tag)::type>(degree, first_knot, spacing, points,
+                                                               t);
+        });
+      },
+      nb::arg("group"), nb::arg("degree"), nb::arg("first_knot"), nb::arg("spacing"),
+      nb::arg("control_points"), nb::arg("t"),
+      "bireg::Spline<G>: pose, body velocity and acceleration at t.");
+}
+
+}  // namespace bireg_python

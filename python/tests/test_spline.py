@@ -1,0 +1,85 @@
+"""SplineRegression through Python: a geodesic reproduced with its velocity,
+degree 1 with one segment equal to GeodesicRegression, left and right
+equivariance, the knot spacing by cross-validation, and ValueError for what
+the C++ refuses."""
+
+import numpy as np
+import pytest
+
+import bireg
+from conftest import geodesic_data
+
+
+def test_a_noise_free_geodesic_is_reproduced_with_its_velocity():
+    # A cubic spline reproduces a geodesic exactly (docs/splines.md and
+    # test_smooth_tool); what is left is the Gauss-Newton tolerance.
+    x = np.array([0.8, -0.4, 1.1])
+    t = np.linspace(0.0, 5.9, 60)
+    Y = bireg.SO3.exp(np.array([0.3, -1.2, 0.5]) + 0 * t[:, None])
+    Y = bireg.SO3.compose(Y, bireg.SO3.exp(t[:, None] * x))
+    spline = bireg.SplineRegression(group="SO3", knot_spacing=0.5).fit(t, Y)
+    assert spline.status_ == "converged"
+    queries = np.linspace(0.2, 5.7, 11)
+    np.testing.assert_allclose(spline.velocity(queries), np.tile(x, (11, 1)), atol=1e-8)
+    np.testing.assert_allclose(spline.acceleration(queries), 0.0, atol=1e-7)
+    expected = bireg.SO3.compose(Y[:1], bireg.SO3.exp(queries[:, None] * x))
+    np.testing.assert_allclose(spline.predict(queries), expected, atol=1e-8)
+
+
+def test_degree_one_with_one_segment_is_the_geodesic(rng):
+    t, Y = geodesic_data("SE3", 50, rng)
+    geodesic = bireg.GeodesicRegression(group="SE3", tol=1e-13).fit(t, Y)
+    spline = bireg.SplineRegression(group="SE3", degree=1, knot_spacing=np.inf,
+                                    tol=1e-13).fit(t, Y)
+    assert spline.control_points_.shape == (2, 4, 4)
+    ends = np.array([t.min(), t.max()])
+    np.testing.assert_allclose(spline.control_points_, geodesic.predict(ends), atol=1e-11)
+
+
+def test_spline_regression_is_left_and_right_equivariant(rng):
+    t, Y = geodesic_data("SE3", 80, rng)
+    a = bireg.SE3.exp(0.5 * rng.standard_normal(6))
+    b = bireg.SE3.exp(0.5 * rng.standard_normal(6))
+    base = bireg.SplineRegression(group="SE3", knot_spacing=0.25, tol=1e-13).fit(t, Y)
+    moved = bireg.SplineRegression(group="SE3", knot_spacing=0.25, tol=1e-13).fit(
+        t, bireg.SE3.compose(bireg.SE3.compose(a, Y), b))
+    np.testing.assert_allclose(moved.control_points_, a @ base.control_points_ @ b, atol=1e-9)
+    queries = np.linspace(t.min(), t.max(), 9)
+    v, vm = base.velocity(queries), moved.velocity(queries)
+    np.testing.assert_allclose(vm, v @ bireg.SE3.Ad(np.linalg.inv(b)).T, atol=1e-8)
+
+
+def test_auto_knot_spacing_reports_its_curve(rng):
+    # Data about one geodesic: one segment (the whole range, the grid's
+    # last value) predicts best, and the user is told the choice is at the
+    # grid's edge.
+    t, Y = geodesic_data("SO3", 120, rng)
+    with pytest.warns(UserWarning, match="the grid's largest value"):
+        spline = bireg.SplineRegression(group="SO3").fit(t, Y)
+    selection = spline.knot_selection_
+    assert selection["knot_spacing"] == selection["grid"][-1]
+    assert selection["knot_spacing"] in selection["grid"]
+    chosen = int(np.flatnonzero(selection["grid"] == selection["knot_spacing"])[0])
+    valid = np.isfinite(selection["criterion"])
+    assert selection["criterion"][chosen] == selection["criterion"][valid].min()
+    assert len(selection["refusals"]) == len(selection["grid"])
+    # Every refused spacing says why.
+    assert all(bool(r) for r, ok in zip(selection["refusals"], valid) if not ok)
+
+
+def test_refusals_are_value_errors(rng):
+    t, Y = geodesic_data("SO3", 30, rng)
+    with pytest.raises(ValueError, match="control points for 30 observations"):
+        bireg.SplineRegression(group="SO3", knot_spacing=1e-4).fit(t, Y)
+    with pytest.raises(ValueError, match="degree must be 1, 2 or 3"):
+        bireg.SplineRegression(group="SO3", degree=4, knot_spacing=0.5).fit(t, Y)
+    with pytest.raises(ValueError, match="knot_spacing must be"):
+        bireg.SplineRegression(group="SO3", knot_spacing="wide").fit(t, Y)
+    with pytest.raises(ValueError, match="knot_spacing must be"):
+        bireg.SplineRegression(group="SO3", knot_spacing=-1.0).fit(t, Y)
+    Y_bad = Y.copy()
+    Y_bad[4, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="observation 4"):
+        bireg.SplineRegression(group="SO3", knot_spacing=0.5).fit(t, Y_bad)
+    with pytest.raises(ValueError, match="not fitted yet"):
+        bireg.SplineRegression(group="SO3").predict(t)
