@@ -53,3 +53,13 @@ def subject_pair(subject, index):
     except (TypeError, ValueError):
         raise ValueError(f"subject {index} must be a pair (t, Y)") from None
     return t, Y
+
+
+def trajectory(t, y, n):
+    """t (N,) and Y (N, n, n) as covariates() and matrices() give them, of
+    equal length."""
+    t = covariates(t)
+    y = matrices(y, n)
+    if t.shape[0] != y.shape[0]:
+        raise ValueError(f"t and Y differ in length ({t.shape[0]} vs {y.shape[0]})")
+    return t, y

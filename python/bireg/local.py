@@ -26,10 +26,7 @@ class LocalRegression:
 
     def fit(self, t, Y):
         group = _groups.get(self.group)
-        t = _arrays.covariates(t)
-        Y = _arrays.matrices(Y, group.matrix_size)
-        if t.shape[0] != Y.shape[0]:
-            raise ValueError(f"t and Y differ in length ({t.shape[0]} vs {Y.shape[0]})")
+        t, Y = _arrays.trajectory(t, Y, group.matrix_size)
         threads = _arrays.positive_int(self.threads, "threads")
         if isinstance(self.bandwidth, str):
             if self.bandwidth != "auto":

@@ -53,10 +53,7 @@ class GeodesicRegression:
         warns with ConvergenceWarning.
         """
         group = _groups.get(self.group)
-        t = _arrays.covariates(t)
-        Y = _arrays.matrices(Y, group.matrix_size)
-        if t.shape[0] != Y.shape[0]:
-            raise ValueError(f"t and Y differ in length ({t.shape[0]} vs {Y.shape[0]})")
+        t, Y = _arrays.trajectory(t, Y, group.matrix_size)
         w = _arrays.weights(sample_weight, t.shape[0])
         self._fit = _bireg.fit(group.name, t, Y, w, self.solver, self.method, float(self.tol),
                                _arrays.positive_int(self.max_iter, "max_iter"),

@@ -44,10 +44,7 @@ class SplineRegression:
         control point and its span); a fit that does not converge sets
         ``status_`` and warns with ConvergenceWarning."""
         group = _groups.get(self.group)
-        t = _arrays.covariates(t)
-        Y = _arrays.matrices(Y, group.matrix_size)
-        if t.shape[0] != Y.shape[0]:
-            raise ValueError(f"t and Y differ in length ({t.shape[0]} vs {Y.shape[0]})")
+        t, Y = _arrays.trajectory(t, Y, group.matrix_size)
         w = _arrays.weights(sample_weight, t.shape[0])
         degree = _arrays.positive_int(self.degree, "degree")
         if isinstance(self.knot_spacing, str):
