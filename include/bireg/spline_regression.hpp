@@ -324,7 +324,7 @@ class SplineRegression {
         }
       }
     };
-    run_chunks(scratch, chunk_sum);
+    run_pieces(scratch.pool, scratch.partials.size(), chunk_sum);
     std::vector<Tangent> sums(knots.control_points, Tangent::Zero());
     std::vector<Scalar> masses(knots.control_points, Scalar(0));
     for (const ChunkPartial& partial : scratch.partials) {
@@ -340,14 +340,15 @@ class SplineRegression {
     return points;
   }
 
-  // body(chunk) for every chunk, on the pool's threads when there is one.
+  // body(piece) for every piece in [0, pieces), on the pool's threads
+  // when there is one.
   template <class Body>
-  static void run_chunks(Scratch& scratch, const Body& body) {
-    if (scratch.pool) {
-      scratch.pool->run(scratch.partials.size(), body);
+  static void run_pieces(ChunkPool* pool, std::size_t pieces, const Body& body) {
+    if (pool) {
+      pool->run(pieces, body);
     } else {
-      for (std::size_t chunk = 0; chunk < scratch.partials.size(); ++chunk)
-        body(chunk);
+      for (std::size_t piece = 0; piece < pieces; ++piece)
+        body(piece);
     }
   }
 
@@ -379,12 +380,7 @@ class SplineRegression {
       }
     };
     const std::size_t pieces = (increments.size() + kIncrementChunk - 1) / kIncrementChunk;
-    if (scratch.pool) {
-      scratch.pool->run(pieces, increment_piece);
-    } else {
-      for (std::size_t piece = 0; piece < pieces; ++piece)
-        increment_piece(piece);
-    }
+    run_pieces(scratch.pool, pieces, increment_piece);
     for (const Tangent& increment : increments) {
       if (!increment.allFinite()) {
         evaluation.finite = false;
@@ -423,7 +419,7 @@ class SplineRegression {
         }
       }
     };
-    run_chunks(scratch, chunk_sum);
+    run_pieces(scratch.pool, scratch.partials.size(), chunk_sum);
     if (jacobian) jacobian->set_zero();
     const std::size_t m = points.size();
     for (const ChunkPartial& partial : scratch.partials) {
