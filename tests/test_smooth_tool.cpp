@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -305,6 +306,53 @@ TEST_CASE("bireg_smooth --method spline: a noise-free SO3 geodesic, its velocity
     REQUIRE(rows[k].status == "ok");
     for (int i = 0; i < 3; ++i)
       REQUIRE(std::abs(rows[k].numbers[static_cast<std::size_t>(i)] - file.velocity[i]) < 1e-8);
+  }
+
+  // Noise-free: no standard errors (empty fields), and stderr says why.
+  REQUIRE(run.err.find("no velocity standard errors: the residuals vanish") != std::string::npos);
+  REQUIRE(std::isnan(rows[0].numbers[3]));
+
+  // With noise of 0.01 rad: every row has standard errors, and the
+  // velocity is within 4 of them of the truth (the cubic spline holds the
+  // geodesic exactly, so the estimate is unbiased). Their size away from
+  // the ends: about sigma sqrt(M / N) / h = 0.01 x sqrt(15 / 60) / 0.5 =
+  // 0.01 rad/s; within a segment of the ends about 10x that, where the
+  // end control point is pinned only by the few observations near it
+  // (B_0 = (1 - u)^3 / 6).
+  std::mt19937 rng(8);
+  std::normal_distribution<double> normal(0.0, 0.01);
+  std::string noisy;
+  for (int k = 0; k < 60; ++k) {
+    const G::Element g =
+        file.at(k / 10.0) * G::exp(G::Tangent(normal(rng), normal(rng), normal(rng)));
+    noisy += std::to_string(100 + k / 10) + "." + std::to_string(k % 10);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c)
+        noisy += ", " + number_text(g(r, c));
+    }
+    noisy += '\n';
+  }
+  const fs::path noisy_velocity = work_dir() / "so3_spline_noisy_velocity.csv";
+  const Run banded =
+      run_tool("--group SO3 --method spline --knot-spacing 0.5 --velocity \"" +
+               noisy_velocity.string() + "\" " + make_file("so3_spline_noisy.csv", noisy));
+  CAPTURE(banded.err);
+  REQUIRE(banded.exit_code == 0);
+  const std::string noisy_text = slurp(noisy_velocity);
+  const std::vector<Line> noisy_rows =
+      parse_csv(noisy_text.substr(split(noisy_text, '\n').at(0).size() + 1));
+  REQUIRE(noisy_rows.size() == 60);
+  for (std::size_t k = 0; k < noisy_rows.size(); ++k) {
+    const Line& row = noisy_rows[k];
+    CAPTURE(row.time);
+    REQUIRE(row.status == "ok");
+    const bool interior = k >= 5 && k < 55;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double se = row.numbers[3 + i];
+      REQUIRE(se > (interior ? 0.002 : 0.0));
+      REQUIRE(se < (interior ? 0.05 : 0.5));
+      REQUIRE(std::abs(row.numbers[i] - file.velocity[int(i)]) < 4 * se);
+    }
   }
 
   // auto: the choice on stderr, the curve in --cv-table.

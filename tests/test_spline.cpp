@@ -23,6 +23,7 @@
 #include "bireg/spline_regression.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "catch.hpp"
+#include "spline_samples.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -32,43 +33,10 @@ using SE3 = bireg::SE3d;
 using Sim3 = bireg::Sim3d;
 using R3 = bireg::Rnd<3>;
 
-template <class G>
-std::vector<typename G::Element> random_points(std::mt19937& rng, std::size_t m, double step) {
-  std::vector<typename G::Element> points{
-      G::exp(bireg_test::normal_tangent<typename G::Tangent>(rng, 1.0))};
-  for (std::size_t c = 1; c < m; ++c) {
-    points.push_back(G::compose(
-        points.back(), G::exp(bireg_test::normal_tangent<typename G::Tangent>(rng, step))));
-  }
-  return points;
-}
-
-// |log(a^{-1} b)|: the distance the tests compare elements by.
-template <class G>
-double distance(const typename G::Element& a, const typename G::Element& b) {
-  return G::log(G::compose(G::inverse(a), b)).norm();
-}
-
-// Noisy samples of a spline at n covariates spread over its range.
-template <class G>
-struct Samples {
-  std::vector<typename G::Element> f;
-  std::vector<double> t;
-};
-
-template <class G>
-Samples<G> sample(const bireg::Spline<G>& curve, std::size_t n, double noise, std::mt19937& rng) {
-  Samples<G> out;
-  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double s = (double(i) + 0.5 + jitter(rng)) / double(n);
-    const double t = curve.t_min() + s * (curve.t_max() - curve.t_min());
-    out.t.push_back(t);
-    out.f.push_back(
-        G::compose(curve(t), G::exp(bireg_test::normal_tangent<typename G::Tangent>(rng, noise))));
-  }
-  return out;
-}
+using bireg_test::distance;
+using bireg_test::random_points;
+using bireg_test::sample;
+using bireg_test::Samples;
 
 }  // namespace
 

@@ -47,12 +47,14 @@
 // (select_knot_spacing over auto_knot_spacing_grid: 24 values from 1.25
 // median sample spacings to the whole range, 5 folds), printed on stderr,
 // and --cv-table FILE writes its curve (CSV: knot_spacing, criterion,
-// failures, refused). Poses and velocities are the spline's at the queries;
-// the velocity's standard errors are not computed yet (empty fields). A
-// knot spacing the data cannot determine is invalid input (exit 2); a fit
-// that fails marks every row failed (exit 3). --bandwidth and --kernel
-// apply to the local method only, --degree and --knot-spacing to the
-// spline only: the other method's options are refused.
+// failures, refused). Poses and velocities are the spline's at the queries,
+// the velocity's standard errors from the fit's sandwich covariance
+// (spline_covariance; empty fields, with the reason on stderr, where it is
+// undefined: noise-free data, no degrees of freedom, or more than 4096
+// control-point coordinates). A knot spacing the data cannot determine is invalid input (exit 2); a
+// fit that fails marks every row failed (exit 3). --bandwidth and --kernel apply to the local
+// method only, --degree and --knot-spacing to the spline only: the other method's options are
+// refused.
 //
 // --threads N (default: every core) shares the queries, and the
 // cross-validation of --bandwidth auto, out to N threads in blocks of 1024
@@ -90,6 +92,7 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/spline_regression.hpp"
+#include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "bireg/version.hpp"
@@ -137,7 +140,7 @@ constexpr const char* kHelp =
     "                     at every input timestamp\n"
     "  --rate HZ          evaluate at first + k / HZ up to the last timestamp\n"
     "  --velocity FILE    write the body velocity (rad/s; m/s for translations) with\n"
-    "                     its standard errors (local method) and a status per row, as CSV\n"
+    "                     its standard errors and a status per row, as CSV\n"
     "  --cv-table FILE    write the cross-validation curves of --bandwidth auto (or of\n"
     "                     --knot-spacing auto) as CSV\n"
     "  --output FILE      the smoothed poses (default: standard output)\n"
@@ -508,6 +511,14 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
   const bireg::SplineResult<G> fit =
       bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
   if (fit.status == bireg::Status::invalid_input) return fail(name + ": " + fit.message);
+  std::optional<bireg::SplineCovariance<G>> covariance;
+  if (fit.ok()) {
+    covariance = bireg::spline_covariance(fit, trajectory.observations, trajectory.covariates);
+    if (!covariance->defined()) {
+      std::fprintf(stderr, "bireg_smooth: %s: no velocity standard errors: %s\n", name.c_str(),
+                   covariance->message.c_str());
+    }
+  }
   estimates.resize(queries.size());
   for (std::size_t q = 0; q < queries.size(); ++q) {
     bireg::LocalEstimate<G>& e = estimates[q];
@@ -518,6 +529,11 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
     e.window = trajectory.observations.size();
     e.pose = (*fit.spline)(queries[q]);
     e.velocity = fit.spline->body_velocity(queries[q]);
+    if (covariance && covariance->defined()) {
+      e.velocity_error =
+          bireg::standard_errors(bireg::velocity_covariance(*covariance, queries[q]));
+      e.velocity_error_defined = true;
+    }
   }
   return std::nullopt;
 }

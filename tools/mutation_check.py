@@ -188,6 +188,21 @@ MUTANTS = [
            "blocks[std::size_t(l - j + k)].noalias() -= weighted;",
            ["test_spline"],
            "the Gauss-Newton matrix without D_l (B_c B_l H kron I only at the identity)"),
+    Mutant("SP4", "include/bireg/regression/spline/differentials.hpp",
+           "g[m] = basis.cumulative_d1[m] * carry + G::ad(earlier) * e;",
+           "g[m] = basis.cumulative_d1[m] * carry - G::ad(earlier) * e;",
+           ["test_spline_inference"],
+           "the suffixes' motion with the wrong sign in the velocity's differential (splines.md (11))"),
+    Mutant("SP5", "include/bireg/statistics/inference/spline_covariance.hpp",
+           "const Scalar nu = problem.weight_sum - trace;",
+           "const Scalar nu = problem.weight_sum;",
+           ["test_spline_inference"],
+           "the noise covariance divided by W, not W - tr(H^{-1} H_2)"),
+    Mutant("SP6", "include/bireg/statistics/inference/spline_covariance.hpp",
+           "c.block(segment + std::size_t(j), segment + std::size_t(l)) *\n                       maps[std::size_t(l)].transpose();",
+           "c.block(segment + std::size_t(j), segment + std::size_t(l)) *\n                       maps[std::size_t(j)].transpose();",
+           ["test_spline_inference"],
+           "a pointwise covariance with one control point's map on both sides"),
 ]
 
 

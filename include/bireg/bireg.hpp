@@ -28,6 +28,7 @@
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/permutation.hpp"
 #include "bireg/statistics/inference/scatter.hpp"
+#include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
 #include "bireg/statistics/robust/loss.hpp"
 #include "bireg/statistics/robust/regression.hpp"

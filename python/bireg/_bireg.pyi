@@ -95,6 +95,11 @@ def spline_fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None
 def spline_evaluate(group: str, degree: int, first_knot: float, spacing: float, control_points: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]) -> dict:
     """bireg::Spline<G>: pose, body velocity and acceleration at t."""
 
+def spline_band(group: str, degree: int, first_knot: float, spacing: float, control_points: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], band: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], noise: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu', writable=False)], nu: float, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], level: float, quantity: str) -> NDArray[numpy.float64]:
+    """
+    bireg::pose_covariance / velocity_covariance of a SplineCovariance: half-widths at t.
+    """
+
 def mean(group: str, y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], tol: float, max_iter: int) -> dict:
     """bireg::mean<G>: a dict with the mean, status, iterations, residuals."""
 

@@ -26,7 +26,11 @@ class SplineRegression:
     ``first_knot_``, ``knot_spacing_`` (the spacing used: the range cut into
     equal segments no longer than asked), ``status_``, ``n_iter_``,
     ``equation_norm_``, ``residuals_`` (N, d), ``knot_selection_`` (a dict
-    for "auto", else None).
+    for "auto", else None), and of the sandwich covariance of the control
+    points (``bireg::spline_covariance``, docs/splines.md §10):
+    ``noise_covariance_`` (d, d) and ``degrees_of_freedom_`` (N - M for
+    unit weights), None where it is undefined, with the reason in
+    ``covariance_message_``.
     """
 
     def __init__(self, group="SE3", degree=3, knot_spacing="auto", tol=1e-10, max_iter=100,
@@ -68,6 +72,10 @@ class SplineRegression:
         self.equation_norm_ = out["equation_norm"]
         self.residuals_ = out["residuals"]
         self.knot_selection_ = out.get("knot_selection")
+        self.noise_covariance_ = out.get("noise_covariance")
+        self.degrees_of_freedom_ = out.get("degrees_of_freedom")
+        self.covariance_message_ = out["covariance_message"]
+        self._band = out.get("covariance_band")
         self._group, self._degree = group, degree
         if self.knot_selection_ is not None and self.knot_selection_["message"]:
             warnings.warn(f"knot spacing auto: {self.knot_selection_['message']}", UserWarning,
@@ -77,9 +85,12 @@ class SplineRegression:
                           ConvergenceWarning, stacklevel=2)
         return self
 
-    def _evaluate(self, t_new):
+    def _check_fitted(self):
         if not hasattr(self, "control_points_"):
             raise ValueError("this SplineRegression is not fitted yet: call fit(t, Y) first")
+
+    def _evaluate(self, t_new):
+        self._check_fitted()
         return _bireg.spline_evaluate(self._group.name, self._degree, self.first_knot_,
                                       self.knot_spacing_, self.control_points_,
                                       _arrays.covariates(t_new))
@@ -96,3 +107,18 @@ class SplineRegression:
     def acceleration(self, t_new):
         """Body acceleration d/dt (T^{-1} dT/dt): (M,) -> (M, d)."""
         return self._evaluate(t_new)["acceleration"]
+
+    def confidence_band(self, t_new, level=0.95, quantity="pose"):
+        """Per covariate, the half-widths of the pointwise ``level``
+        confidence region of the pose (left-trivialised: T^ = T exp(eps)) or
+        of the body velocity (``quantity="velocity"``) along each body-frame
+        coordinate (Hotelling's T^2 with ``degrees_of_freedom_``): (M,) ->
+        (M, d). ValueError where the covariance is undefined (noise-free
+        data, no degrees of freedom left, too many control points)."""
+        self._check_fitted()
+        if self._band is None:
+            raise ValueError(f"the spline's covariance is undefined: {self.covariance_message_}")
+        return _bireg.spline_band(self._group.name, self._degree, self.first_knot_,
+                                  self.knot_spacing_, self.control_points_, self._band,
+                                  self.noise_covariance_, float(self.degrees_of_freedom_),
+                                  _arrays.covariates(t_new), float(level), str(quantity))

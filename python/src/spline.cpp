@@ -1,12 +1,15 @@
 // The regression layer's spline (bireg/spline_regression.hpp): the fit, with
-// the knot spacing by cross-validation when asked, and the curve's pose,
-// body velocity and acceleration at new covariates. The GIL is released
-// while the library works.
+// the knot spacing by cross-validation when asked and its sandwich
+// covariance (bireg/statistics/inference/spline_covariance.hpp), the
+// curve's pose, body velocity and acceleration at new covariates, and the
+// pointwise confidence half-widths. The GIL is released while the library
+// works.
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "bireg/spline_regression.hpp"
+#include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "common.hpp"
 
@@ -36,6 +39,7 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
   options.threads = threads;
   nb::dict out;
   bireg::SplineResult<G> fit;
+  bireg::SplineCovariance<G> covariance;
   bireg::KnotSpacingSelection<double> selection;
   const bool automatic = !(knot_spacing > 0);
   {
@@ -49,6 +53,7 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
     }
     if (!automatic || selection.ok())
       fit = bireg::SplineRegression<G>(options).fit(poses, covariates, weights);
+    if (fit.ok()) covariance = bireg::spline_covariance(fit, poses, covariates, weights);
   }
   if (automatic) {
     if (!selection.ok()) refuse("knot spacing auto: " + selection.message);
@@ -72,7 +77,32 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
   out["knot_spacing"] = fit.spline->knot_spacing();
   out["control_points"] = element_stack<G>(fit.spline->control_points());
   out["residuals"] = tangent_rows<G>(fit.residuals);
+  // The covariance's band, (M (2k + 1), d, d) in SplineCovariance's order,
+  // S and nu; or why it is undefined.
+  out["covariance_message"] = covariance.message;
+  if (covariance.defined()) {
+    const std::size_t d = std::size_t(G::dof);
+    NewArray band({covariance.band.size(), d, d});
+    for (std::size_t b = 0; b < covariance.band.size(); ++b)
+      write_row_major(covariance.band[b], band.data() + b * d * d);
+    out["covariance_band"] = band.release();
+    out["noise_covariance"] = matrix_array(covariance.residual);
+    out["degrees_of_freedom"] = covariance.degrees_of_freedom;
+  }
   return out;
+}
+
+// The curve of a fit's knots and control points, checked.
+template <class G>
+bireg::Spline<G> curve_of(int degree, double first_knot, double spacing, const Stack& points) {
+  if (degree < 1 || degree > bireg::kMaxSplineDegree) refuse("degree must be 1, 2 or 3");
+  if (!(spacing > 0) || !std::isfinite(first_knot)) refuse("the knots must be finite, spacing > 0");
+  if (points.shape(0) <= std::size_t(degree)) refuse("too few control points for the degree");
+  const StackView<G> view(points);
+  std::vector<typename G::Element> elements;
+  for (std::size_t c = 0; c < view.size(); ++c)
+    elements.push_back(view[c]);
+  return bireg::Spline<G>(degree, first_knot, spacing, std::move(elements));
 }
 
 // The curve of control points `points` at t: pose, body velocity and body
@@ -80,15 +110,8 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
 template <class G>
 nb::dict evaluate_spline(int degree, double first_knot, double spacing, const Stack& points,
                          const Vector& t) {
-  if (degree < 1 || degree > bireg::kMaxSplineDegree) refuse("degree must be 1, 2 or 3");
-  if (!(spacing > 0) || !std::isfinite(first_knot)) refuse("the knots must be finite, spacing > 0");
-  if (points.shape(0) <= std::size_t(degree)) refuse("too few control points for the degree");
+  const bireg::Spline<G> curve = curve_of<G>(degree, first_knot, spacing, points);
   check_covariates(t, "spline");
-  const StackView<G> view(points);
-  std::vector<typename G::Element> elements;
-  for (std::size_t c = 0; c < view.size(); ++c)
-    elements.push_back(view[c]);
-  const bireg::Spline<G> curve(degree, first_knot, spacing, std::move(elements));
   const std::size_t count = t.shape(0), n = std::size_t(side<G>());
   NewArray pose({count, n, n});
   std::vector<typename G::Tangent> velocity(count), acceleration(count);
@@ -103,6 +126,45 @@ nb::dict evaluate_spline(int degree, double first_knot, double spacing, const St
   out["velocity"] = tangent_rows<G>(velocity);
   out["acceleration"] = tangent_rows<G>(acceleration);
   return out;
+}
+
+// The half-widths of the pointwise `level` confidence regions of the pose
+// or the body velocity at t (bireg::pointwise_quantile, half_widths), from
+// the covariance fit_spline returned.
+template <class G>
+Output spline_band(int degree, double first_knot, double spacing, const Stack& points,
+                   const Stack& band, const Matrix& noise, double nu, const Vector& t, double level,
+                   const std::string& quantity) {
+  using AdMatrix = typename G::AdMatrix;
+  constexpr std::size_t d = std::size_t(G::dof);
+  if (!(level > 0 && level < 1)) refuse("confidence_band: level must lie in (0, 1)");
+  if (quantity != "pose" && quantity != "velocity")
+    refuse("confidence_band: quantity must be 'pose' or 'velocity', got '" + quantity + "'");
+  bireg::SplineCovariance<G> c;
+  c.spline = curve_of<G>(degree, first_knot, spacing, points);
+  const std::size_t expected = points.shape(0) * (2 * std::size_t(degree) + 1);
+  if (band.shape(0) != expected || band.shape(1) != d || band.shape(2) != d ||
+      noise.shape(0) != d || noise.shape(1) != d)
+    refuse("confidence_band: the covariance does not match the control points");
+  c.band.resize(expected);
+  for (std::size_t b = 0; b < expected; ++b)
+    c.band[b] = Eigen::Map<const Eigen::Matrix<double, int(d), int(d), Eigen::RowMajor>>(
+        band.data() + b * d * d);
+  c.residual =
+      Eigen::Map<const Eigen::Matrix<double, int(d), int(d), Eigen::RowMajor>>(noise.data());
+  c.degrees_of_freedom = nu;
+  c.status = bireg::CovarianceStatus::defined;
+  check_covariates(t, "confidence_band");
+  const std::optional<double> q = bireg::pointwise_quantile(c, level);
+  if (!q) refuse("confidence_band: too few degrees of freedom for a quantile at this level");
+  std::vector<typename G::Tangent> rows(t.shape(0));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double at = t.data()[i];
+    const AdMatrix covariance =
+        quantity == "pose" ? bireg::pose_covariance(c, at) : bireg::velocity_covariance(c, at);
+    rows[i] = bireg::half_widths(covariance, *q);
+  }
+  return tangent_rows<G>(rows);
 }
 
 }  // namespace
@@ -132,6 +194,20 @@ void bind_spline(nb::module_& m) {
       nb::arg("group"), nb::arg("degree"), nb::arg("first_knot"), nb::arg("spacing"),
       nb::arg("control_points"), nb::arg("t"),
       "bireg::Spline<G>: pose, body velocity and acceleration at t.");
+  m.def(
+      "spline_band",
+      [](const std::string& group, int degree, double first_knot, double spacing,
+         const Stack& points, const Stack& band, const Matrix& noise, double nu, const Vector& t,
+         double level, const std::string& quantity) {
+        return with_group(group, [&](auto tag) {
+          return spline_band<typename decltype(tag)::type>(degree, first_knot, spacing, points,
+                                                           band, noise, nu, t, level, quantity);
+        });
+      },
+      nb::arg("group"), nb::arg("degree"), nb::arg("first_knot"), nb::arg("spacing"),
+      nb::arg("control_points"), nb::arg("band"), nb::arg("noise"), nb::arg("nu"), nb::arg("t"),
+      nb::arg("level"), nb::arg("quantity"),
+      "bireg::pose_covariance / velocity_covariance of a SplineCovariance: half-widths at t.");
 }
 
 }  // namespace bireg_python

@@ -1,7 +1,8 @@
 """SplineRegression through Python: a geodesic reproduced with its velocity,
 degree 1 with one segment equal to GeodesicRegression, left and right
-equivariance, the knot spacing by cross-validation, and ValueError for what
-the C++ refuses."""
+equivariance, the knot spacing by cross-validation, the confidence bands
+(one segment's against the geodesic's), and ValueError for what the C++
+refuses."""
 
 import numpy as np
 import pytest
@@ -83,3 +84,45 @@ def test_refusals_are_value_errors(rng):
         bireg.SplineRegression(group="SO3", knot_spacing=0.5).fit(t, Y_bad)
     with pytest.raises(ValueError, match="not fitted yet"):
         bireg.SplineRegression(group="SO3").predict(t)
+
+
+def test_confidence_band_of_one_segment_is_the_geodesics(rng):
+    # Degree 1 on one segment is the geodesic, and its sandwich covariance
+    # the geodesic's homoscedastic one up to the Gauss-Newton matrices'
+    # J_l(r)^{-1} = I + O(|r|) (tests/test_spline_inference.cpp): within
+    # about the noise, 0.01, relative.
+    t, Y = geodesic_data("SE3", 50, rng, noise=0.01)
+    spline = bireg.SplineRegression(group="SE3", degree=1, knot_spacing=np.inf,
+                                    tol=1e-13).fit(t, Y)
+    geodesic = bireg.GeodesicRegression(group="SE3", tol=1e-13).fit(t, Y)
+    assert spline.degrees_of_freedom_ == pytest.approx(48)
+    assert spline.noise_covariance_.shape == (6, 6)
+    queries = np.linspace(t.min(), t.max(), 7)
+    np.testing.assert_allclose(spline.confidence_band(queries),
+                               geodesic.confidence_band(queries, flavour="homoscedastic"),
+                               rtol=0.01)
+    velocity = spline.confidence_band(queries, level=0.9, quantity="velocity")
+    assert velocity.shape == (7, 6)
+    assert np.all(np.isfinite(velocity)) and np.all(velocity > 0)
+    # A wider level, a wider band.
+    assert np.all(spline.confidence_band(queries, level=0.99) >
+                  spline.confidence_band(queries, level=0.9))
+
+
+def test_confidence_band_refusals(rng):
+    # Noise-free data: the covariance is undefined, and says why.
+    t = np.linspace(0.0, 1.0, 40)
+    Y = bireg.SO3.exp(t[:, None] * np.array([0.4, -0.2, 0.9]))
+    spline = bireg.SplineRegression(group="SO3", knot_spacing=0.25).fit(t, Y)
+    assert spline.noise_covariance_ is None
+    assert "vanish" in spline.covariance_message_
+    with pytest.raises(ValueError, match="covariance is undefined.*vanish"):
+        spline.confidence_band(t)
+    t, Y = geodesic_data("SO3", 40, rng)
+    spline = bireg.SplineRegression(group="SO3", knot_spacing=0.25).fit(t, Y)
+    with pytest.raises(ValueError, match="level must lie in"):
+        spline.confidence_band(t, level=1.5)
+    with pytest.raises(ValueError, match="quantity must be"):
+        spline.confidence_band(t, quantity="acceleration")
+    with pytest.raises(ValueError, match="not fitted yet"):
+        bireg.SplineRegression(group="SO3").confidence_band(t)

@@ -4,7 +4,8 @@
 // pivoting between blocks (K -> -H kron I near the identity, H = B^T W B
 // positive definite under Schoenberg-Whitney, where block elimination
 // needs no pivoting) and partial pivoting within each d x d pivot.
-// O(M k^2 d^3); no allocation after construction.
+// O(M k^2 d^3) to factor, O(M k d^2) per solve after that; no
+// allocation after construction.
 #pragma once
 
 #include <algorithm>
@@ -32,7 +33,10 @@ class BlockBandedMatrix {
   std::size_t rows() const { return rows_; }
   std::size_t band() const { return band_; }
 
-  void set_zero() { std::fill(blocks_.begin(), blocks_.end(), Block::Zero()); }
+  void set_zero() {
+    std::fill(blocks_.begin(), blocks_.end(), Block::Zero());
+    factored_ = false;
+  }
 
   // Block (c, l); precondition |c - l| <= band.
   Block& operator()(std::size_t c, std::size_t l) { return blocks_[index(c, l)]; }
@@ -40,23 +44,40 @@ class BlockBandedMatrix {
 
   // Solves K x = rhs in place. False (rhs then unspecified) when a pivot
   // is singular to working precision or the solution is not finite.
-  bool solve(std::vector<Vector>& rhs) {
+  bool solve(std::vector<Vector>& rhs) { return factorize() && substitute(rhs); }
+
+  // The block LU of K, kept for substitute(): false when a pivot is
+  // singular to working precision (U's diagonal within a pivot spans more
+  // than 1/eps, a cheap stand-in for the condition number).
+  bool factorize() {
     work_ = blocks_;
+    factored_ = false;
     const Scalar tiny = std::numeric_limits<Scalar>::epsilon();
     for (std::size_t c = 0; c < rows_; ++c) {
       const Eigen::PartialPivLU<Block> pivot(at(c, c));
-      // Singular to working precision: U's diagonal spans more than 1/eps
-      // (a cheap stand-in for the condition number).
       const auto diagonal = pivot.matrixLU().diagonal().cwiseAbs();
       if (!(diagonal.minCoeff() > tiny * diagonal.maxCoeff())) return false;
       pivot_inverse_[c] = pivot.inverse();
       const std::size_t last = std::min(rows_ - 1, c + band_);
       for (std::size_t r = c + 1; r <= last; ++r) {
-        const Block multiplier = at(r, c) * pivot_inverse_[c];
+        at(r, c) = at(r, c) * pivot_inverse_[c];  // the multiplier, L's block
         for (std::size_t q = c + 1; q <= last; ++q)
-          at(r, q).noalias() -= multiplier * at(c, q);
-        rhs[r].noalias() -= multiplier * rhs[c];
+          at(r, q).noalias() -= at(r, c) * at(c, q);
       }
+    }
+    factored_ = true;
+    return true;
+  }
+
+  // Solves K x = rhs in place with the last factorize()'s LU (a
+  // precondition: it returned true since K last changed). False when the
+  // solution is not finite.
+  bool substitute(std::vector<Vector>& rhs) const {
+    if (!factored_) return false;
+    for (std::size_t c = 0; c < rows_; ++c) {
+      const std::size_t last = std::min(rows_ - 1, c + band_);
+      for (std::size_t r = c + 1; r <= last; ++r)
+        rhs[r].noalias() -= at(r, c) * rhs[c];
     }
     for (std::size_t c = rows_; c-- > 0;) {
       Vector sum = rhs[c];
@@ -74,9 +95,11 @@ class BlockBandedMatrix {
     return c * (2 * band_ + 1) + (l + band_ - c);
   }
   Block& at(std::size_t c, std::size_t l) { return work_[index(c, l)]; }
+  const Block& at(std::size_t c, std::size_t l) const { return work_[index(c, l)]; }
 
   std::size_t rows_, band_;
   std::vector<Block> blocks_, work_, pivot_inverse_;
+  bool factored_ = false;
 };
 
 }  // namespace bireg

@@ -96,4 +96,40 @@ void control_point_differentials(int degree, const SplineBasis<typename G::Scala
   out.weight[k] = b[k] * (jacobians[k - 1].right * last_inverse);
 }
 
+// The body velocity's differential in the segment's control points
+// (splines.md (11)): omega(t) after P_{i+j} -> P_{i+j} exp(delta) is
+// omega(t) + V_j delta + O(delta^2), per covariate unit for knot spacing h.
+// With E_m as above and y_j = Ad_{S_j^{-1}} Omega_j,
+//
+//   G_m = b_m' Ad_{S_m^{-1}} + ad(sum_{j < m} b_j' y_j) E_m,
+//   V_j = ([j >= 1] G_j J_r(Omega_j)^{-1} - [j < k] G_{j+1} J_l(Omega_{j+1})^{-1}) / h.
+template <class G>
+void velocity_differentials(int degree, typename G::Scalar h,
+                            const SplineBasis<typename G::Scalar>& basis,
+                            const SegmentProduct<G>& product,
+                            const IncrementJacobians<G>* jacobians,
+                            std::array<typename G::AdMatrix, kMaxSplineDegree + 1>& out) {
+  using AdMatrix = typename G::AdMatrix;
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  const int k = degree;
+  std::array<AdMatrix, kMaxSplineDegree + 1> g;
+  for (AdMatrix& block : g)
+    block.setZero();                  // g[0] is unused
+  Tangent earlier = Tangent::Zero();  // sum_{j < m} b_j' y_j
+  for (int m = 1; m <= k; ++m) {
+    const AdMatrix carry = G::Ad(G::inverse(product.suffix[m]));
+    const Scalar b = basis.cumulative[m];
+    const AdMatrix e = b * (carry * right_jacobian<G>((b * product.omega[m]).eval()));
+    g[m] = basis.cumulative_d1[m] * carry + G::ad(earlier) * e;
+    earlier += basis.cumulative_d1[m] * (carry * product.omega[m]);
+  }
+  for (int j = 0; j <= k; ++j) {
+    AdMatrix v = AdMatrix::Zero();
+    if (j >= 1) v += g[j] * jacobians[j - 1].right_inverse;
+    if (j < k) v -= g[j + 1] * jacobians[j].left_inverse;
+    out[std::size_t(j)] = v / h;
+  }
+}
+
 }  // namespace bireg
