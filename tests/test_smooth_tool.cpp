@@ -366,6 +366,19 @@ TEST_CASE("bireg_smooth --method spline: a noise-free SO3 geodesic, its velocity
   REQUIRE(curve.at(0) == "knot_spacing,criterion,failures,refused");
   REQUIRE(curve.size() >= 25);  // the header and 24 spacings
 
+  // A knot span that turns by 2.56 rad (5.2 rad/s; the 5.9 s range cut
+  // into 12 spans of 0.4917 s, the fewest no longer than 0.5 s): a warning
+  // that names the control points.
+  const GeodesicFile<G> fast =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.0, 5.2, 0.0), 60);
+  const Run turning = run_tool("--group SO3 --method spline --knot-spacing 0.5 " +
+                               make_file("so3_spline_fast.csv", fast.text));
+  CAPTURE(turning.err);
+  REQUIRE(turning.exit_code == 0);
+  REQUIRE(turning.err.find("warning: the spline turns by 2.56 rad between control points") !=
+          std::string::npos);
+  REQUIRE(turning.err.find("use a narrower --knot-spacing") != std::string::npos);
+
   // Knots the data cannot determine: invalid input, named.
   const Run dense = run_tool("--group SO3 --method spline --knot-spacing 0.01 " + input);
   REQUIRE(dense.exit_code == 2);

@@ -8,6 +8,7 @@
 // second-order failure for degree 3, and the refusals.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -445,4 +446,53 @@ TEST_CASE("Spline fit: bit-identical for any thread count", "[spline][threads]")
   options.threads = 0;
   CHECK(bireg::SplineRegression<SO3>(options).fit(data.f, data.t).message ==
         "threads must be at least 1, got 0");
+}
+
+// A spin about z at 2.6 rad per knot span: every increment turns by about
+// 2.6 rad, past 3 pi / 4 = 2.36, where the principal log of a span is near
+// its jump; at 2.0 rad per span nothing is flagged. A gross outlier (a half
+// turn away, weight 1) is named as the geodesic's diagnostics name it.
+TEST_CASE("Spline fit reports spans and residuals near the log's cut locus", "[spline]") {
+  const auto spin = [](double rate, std::size_t outlier) {
+    Samples<SO3> data;
+    for (std::size_t i = 0; i <= 200; ++i) {
+      const double t = 4.0 * double(i) / 200;
+      data.t.push_back(t);
+      data.f.push_back(SO3::exp(SO3::Tangent(0.0, 0.0, rate * t)));
+    }
+    if (outlier < data.f.size())
+      data.f[outlier] = SO3::compose(data.f[outlier], SO3::exp(SO3::Tangent(2.9, 0.0, 0.0)));
+    return data;
+  };
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = 1.0;
+  const Samples<SO3> slow = spin(2.0, 1000);
+  const auto calm = bireg::SplineRegression<SO3>(options).fit(slow.f, slow.t);
+  REQUIRE(calm.ok());
+  CHECK_FALSE(calm.beyond_domain);
+  CHECK(calm.largest_increment_angle == Approx(2.0).epsilon(0.05));
+  const Samples<SO3> fast = spin(2.6, 1000);
+  const auto near = bireg::SplineRegression<SO3>(options).fit(fast.f, fast.t);
+  REQUIRE(near.ok());
+  CHECK(near.beyond_domain);
+  CHECK(near.largest_increment_angle > 2.36);
+  CHECK(near.largest_increment >= 1);
+  CHECK(near.largest_residual_angle < 1e-6);
+  const Samples<SO3> bad = spin(2.0, 77);
+  const auto outlier = bireg::SplineRegression<SO3>(options).fit(bad.f, bad.t);
+  REQUIRE(outlier.ok());
+  CHECK(outlier.beyond_domain);
+  CHECK(outlier.largest_residual_observation == 77);
+  CHECK(outlier.largest_residual_angle > 2.36);
+
+  // One cubic segment over a 3.2 rad turn: its control points would have
+  // to lie more than a half turn apart (B-spline control points extend past
+  // the curve), and the failure says so rather than blaming dense knots.
+  options.knot_spacing = std::numeric_limits<double>::infinity();
+  const Samples<SO3> turn = spin(0.8, 1000);
+  const auto wide = bireg::SplineRegression<SO3>(options).fit(turn.f, turn.t);
+  INFO(wide.message);
+  CHECK(wide.status == bireg::Status::no_descent);
+  CHECK(wide.message.find("half turn") != std::string::npos);
+  CHECK(wide.message.find("try a narrower knot spacing") != std::string::npos);
 }

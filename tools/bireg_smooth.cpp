@@ -511,6 +511,23 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
   const bireg::SplineResult<G> fit =
       bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
   if (fit.status == bireg::Status::invalid_input) return fail(name + ": " + fit.message);
+  // Near the log's cut locus (SplineResult::beyond_domain): say where.
+  if (fit.ok() && fit.largest_residual_angle > bireg::kBeyondDomainAngle<double>) {
+    const auto observation = static_cast<std::size_t>(fit.largest_residual_observation);
+    std::fprintf(stderr,
+                 "bireg_smooth: %s: warning: this observation lies %.3g rad from the fitted "
+                 "spline, beyond 3 pi/4: a gross outlier, or motion too fast for the knots\n",
+                 bireg_cli::where(name, trajectory.lines[observation]).c_str(),
+                 fit.largest_residual_angle);
+  }
+  if (fit.ok() && fit.largest_increment_angle > bireg::kBeyondDomainAngle<double>) {
+    std::fprintf(stderr,
+                 "bireg_smooth: %s: warning: the spline turns by %.3g rad between control "
+                 "points %td and %td, beyond 3 pi/4 (a half turn is where it jumps): use a "
+                 "narrower --knot-spacing\n",
+                 name.c_str(), fit.largest_increment_angle, fit.largest_increment - 1,
+                 fit.largest_increment);
+  }
   std::optional<bireg::SplineCovariance<G>> covariance;
   if (fit.ok()) {
     covariance = bireg::spline_covariance(fit, trajectory.observations, trajectory.covariates);

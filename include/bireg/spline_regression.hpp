@@ -44,6 +44,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/regression/diagnostics.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/spline/banded.hpp"
@@ -93,6 +94,22 @@ struct SplineResult {
   // max_c |F_c| at the returned control points (splines.md (6)), weights
   // normalised to a largest of 1.
   Scalar equation_norm = 0;
+  // Where the curve nears the principal log's cut locus, as the geodesic's
+  // diagnostics report it (RegressionDiagnostics): the largest rotation
+  // angle (spectral radius of ad) of a residual and its observation, and of
+  // an increment Omega_j = log(P_{j-1}^{-1} P_j) (one knot span's turn)
+  // and its j. For groups without a closed-form spectral radius (groups/
+  // capabilities.hpp): 0 and -1. beyond_domain: either exceeds
+  // kBeyondDomainAngle (3 pi / 4): an observation lies near a half turn
+  // from the curve (a gross outlier, or motion too fast for the knots), or
+  // a knot span turns by nearly pi, where the increment's principal log,
+  // and with it the curve, is about to jump; a narrower knot spacing is
+  // the remedy for both.
+  Scalar largest_residual_angle = 0;
+  std::ptrdiff_t largest_residual_observation = -1;
+  Scalar largest_increment_angle = 0;
+  std::ptrdiff_t largest_increment = -1;
+  bool beyond_domain = false;
 
   bool ok() const { return is_success(status); }
 };
@@ -438,12 +455,17 @@ class SplineRegression {
     evaluation.finite = std::isfinite(evaluation.merit);
   }
 
-  // Why no step reduced |F|, from what the last iterate shows: residuals
-  // near a half turn (the curve cannot follow the data: knots too sparse
-  // for the motion, or the data leave the log's domain) or a step far
-  // larger than the data's spread (the equations are nearly singular:
-  // knots too dense for the data).
+  // Why no step reduced |F|, from what the last iterate shows, in this
+  // order: residuals near a half turn (the curve cannot follow the data:
+  // knots too sparse for the motion, or the data leave the log's domain);
+  // a step far larger than the data's spread with fewer than three
+  // observations per control point (nearly singular equations: knots too
+  // dense for the data); consecutive control points near a half turn apart
+  // (a span would have to turn past the increments' principal log: one
+  // cubic segment over a motion of a few radians needs control points far
+  // outside the data); a large step alone.
   static std::string no_descent_message(const std::vector<Tangent>& residuals,
+                                        const std::vector<Element>& points,
                                         const std::vector<Tangent>& step) {
     constexpr Scalar kHalfTurn = Scalar(3.14159265358979323846);
     std::ptrdiff_t far = -1;
@@ -463,12 +485,31 @@ class SplineRegression {
     Scalar largest = 0;
     for (const Tangent& s : step)
       largest = std::max(largest, s.template lpNorm<Eigen::Infinity>());
-    if (largest > 1) {
-      return why + "the equations are nearly singular (proposed step " +
-             std::to_string(double(largest)) +
-             " rad): the knots are too dense for the data (spans with about one observation); "
-             "try a wider knot spacing";
+    // Fewer than three observations per control point: spans with about
+    // one each, where the equations are nearly singular.
+    const bool sparse_data = residuals.size() < 3 * points.size();
+    const std::string dense = "the equations are nearly singular (proposed step " +
+                              std::to_string(double(largest)) + " rad): ";
+    if (largest > 1 && sparse_data) {
+      return why + dense +
+             "the knots are too dense for the data (spans with about one observation); try a "
+             "wider knot spacing";
     }
+    std::size_t span = 0;
+    Scalar widest = 0;
+    for (std::size_t j = 1; j < points.size(); ++j) {
+      const Scalar turn =
+          ad_spectral_radius<G>(G::log(G::compose(G::inverse(points[j - 1]), points[j])));
+      if (turn > widest) span = j, widest = turn;
+    }
+    if (widest > kBeyondDomainAngle<Scalar>) {
+      return why + "control points " + std::to_string(span - 1) + " and " + std::to_string(span) +
+             " are " + std::to_string(double(widest)) +
+             " rad apart, near the half turn where their increment's log jumps: the motion "
+             "within a knot span is too large for the spline's control points; try a narrower "
+             "knot spacing";
+    }
+    if (largest > 1) return why + dense + "try another knot spacing";
     return why + "the largest residual is " + std::to_string(double(farthest)) +
            " rad; the equations have no solution reachable from the start at this knot spacing";
   }
@@ -595,7 +636,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       // data's precision, otherwise outside the estimator's domain.
       const bool floor = norm <= std::sqrt(std::numeric_limits<Scalar>::epsilon());
       result.status = floor ? Status::rounding_floor : Status::no_descent;
-      if (!floor) result.message = no_descent_message(result.residuals, step);
+      if (!floor) result.message = no_descent_message(result.residuals, points, step);
       break;
     }
   }
@@ -605,6 +646,26 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   const Wide h = (problem.t_max - problem.t_min) / Wide(knots.segments);
   result.spline = Spline<G>(options_.degree, static_cast<Scalar>(problem.t_min),
                             static_cast<Scalar>(h), std::move(points));
+  if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(problem.w[i] > 0)) continue;  // a zero weight takes the observation out of the fit
+      const Scalar angle = G::ad_spectral_radius(result.residuals[i]);
+      if (angle > result.largest_residual_angle) {
+        result.largest_residual_angle = angle;
+        result.largest_residual_observation = static_cast<std::ptrdiff_t>(i);
+      }
+    }
+    const std::vector<Tangent>& increments = result.spline->increments();
+    for (std::size_t j = 0; j < increments.size(); ++j) {
+      const Scalar angle = G::ad_spectral_radius(increments[j]);
+      if (angle > result.largest_increment_angle) {
+        result.largest_increment_angle = angle;
+        result.largest_increment = static_cast<std::ptrdiff_t>(j + 1);
+      }
+    }
+    result.beyond_domain = result.largest_residual_angle > kBeyondDomainAngle<Scalar> ||
+                           result.largest_increment_angle > kBeyondDomainAngle<Scalar>;
+  }
   return result;
 }
 

@@ -26,7 +26,9 @@ class SplineRegression:
     ``first_knot_``, ``knot_spacing_`` (the spacing used: the range cut into
     equal segments no longer than asked), ``status_``, ``n_iter_``,
     ``equation_norm_``, ``residuals_`` (N, d), ``knot_selection_`` (a dict
-    for "auto", else None), and of the sandwich covariance of the control
+    for "auto", else None), ``diagnostics_`` (a dict: the largest residual
+    and knot-span angles and where they are, and ``beyond_domain``: either
+    past 3 pi / 4, near the log's cut locus; a UserWarning says so), and of the sandwich covariance of the control
     points (``bireg::spline_covariance``, docs/splines.md §10):
     ``noise_covariance_`` (d, d) and ``degrees_of_freedom_`` (N - M for
     unit weights), None where it is undefined, with the reason in
@@ -71,6 +73,7 @@ class SplineRegression:
         self.n_iter_ = out["iterations"]
         self.equation_norm_ = out["equation_norm"]
         self.residuals_ = out["residuals"]
+        self.diagnostics_ = out["diagnostics"]
         self.knot_selection_ = out.get("knot_selection")
         self.noise_covariance_ = out.get("noise_covariance")
         self.degrees_of_freedom_ = out.get("degrees_of_freedom")
@@ -80,6 +83,15 @@ class SplineRegression:
         if self.knot_selection_ is not None and self.knot_selection_["message"]:
             warnings.warn(f"knot spacing auto: {self.knot_selection_['message']}", UserWarning,
                           stacklevel=2)
+        if self.diagnostics_["beyond_domain"] and self.status_ in _SUCCESS:
+            d = self.diagnostics_
+            warnings.warn(
+                "the spline nears the log's cut locus (beyond 3 pi/4): the largest residual "
+                f"angle is {d['largest_residual_angle']:.3g} rad (observation "
+                f"{d['largest_residual_observation']}), the largest knot span's turn "
+                f"{d['largest_increment_angle']:.3g} rad (control points "
+                f"{d['largest_increment'] - 1} to {d['largest_increment']}); a gross outlier, "
+                "or knots too sparse for the motion", UserWarning, stacklevel=2)
         if self.status_ not in _SUCCESS:
             warnings.warn(f"the spline fit ended {self.status_}: {out['message']}",
                           ConvergenceWarning, stacklevel=2)

@@ -77,6 +77,13 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
   out["knot_spacing"] = fit.spline->knot_spacing();
   out["control_points"] = element_stack<G>(fit.spline->control_points());
   out["residuals"] = tangent_rows<G>(fit.residuals);
+  nb::dict diagnostics;  // SplineResult's cut-locus report
+  diagnostics["largest_residual_angle"] = fit.largest_residual_angle;
+  diagnostics["largest_residual_observation"] = fit.largest_residual_observation;
+  diagnostics["largest_increment_angle"] = fit.largest_increment_angle;
+  diagnostics["largest_increment"] = fit.largest_increment;
+  diagnostics["beyond_domain"] = fit.beyond_domain;
+  out["diagnostics"] = diagnostics;
   // The covariance's band, (M (2k + 1), d, d) in SplineCovariance's order,
   // S and nu; or why it is undefined.
   out["covariance_message"] = covariance.message;

@@ -126,3 +126,13 @@ def test_confidence_band_refusals(rng):
         spline.confidence_band(t, quantity="acceleration")
     with pytest.raises(ValueError, match="not fitted yet"):
         bireg.SplineRegression(group="SO3").confidence_band(t)
+
+
+def test_a_knot_span_near_a_half_turn_is_reported():
+    # 2.6 rad per knot span about z (tests/test_spline.cpp): past 3 pi / 4.
+    t = np.linspace(0.0, 4.0, 201)
+    Y = bireg.SO3.exp(t[:, None] * np.array([0.0, 0.0, 2.6]))
+    with pytest.warns(UserWarning, match="cut locus"):
+        spline = bireg.SplineRegression(group="SO3", knot_spacing=1.0).fit(t, Y)
+    assert spline.diagnostics_["beyond_domain"]
+    assert spline.diagnostics_["largest_increment_angle"] > 0.75 * np.pi
