@@ -144,6 +144,44 @@ class SplineRegression {
     return run(observations, covariates, weights, &start);
   }
 
+  // The estimating equations F_c of splines.md (6) at `points` for the
+  // data fit() would be given (weights normalised to a largest of 1, as
+  // fit()'s equation_norm): what a fit drives to zero, for diagnostics and
+  // for iterations of one's own (the Exp-stepped P_c <- P_c exp(lambda F_c)
+  // of splines.md §7). Input is checked as fit() checks it, `points` as
+  // fit_from() checks its start; a refusal is the message, and F is then
+  // empty. F is empty too where it is not finite (consecutive control
+  // points or residuals outside the log's domain), with that message.
+  struct Equations {
+    std::string message;
+    std::vector<Tangent> force;
+    bool ok() const { return message.empty(); }
+  };
+
+  template <class Observations, class Covariates>
+  Equations equations(const std::vector<Element>& points, const Observations& observations,
+                      const Covariates& covariates, const std::vector<Scalar>& weights = {}) const {
+    Equations out;
+    Prepared prepared;
+    if (auto rejection = prepare(observations, covariates, weights, &points, prepared)) {
+      out.message = rejection->message;
+      return out;
+    }
+    ChunkPool* const pool = prepared.pool ? &*prepared.pool : nullptr;
+    Scratch scratch(prepared.problem, prepared.knots, std::move(prepared.order), options_.degree,
+                    pool);
+    Evaluation evaluation(prepared.knots.control_points);
+    std::vector<Tangent> residuals(observations.size());
+    evaluate(observations, prepared.problem, prepared.knots, points, residuals, nullptr, scratch,
+             evaluation);
+    if (!evaluation.finite) {
+      out.message = "the estimating equations are not finite at these control points";
+      return out;
+    }
+    out.force = std::move(evaluation.force);
+    return out;
+  }
+
  private:
   // The knots on the unit interval: S segments of length h = 1/S.
   struct Knots {
@@ -514,6 +552,21 @@ class SplineRegression {
            " rad; the equations have no solution reachable from the start at this knot spacing";
   }
 
+  // What fit() and equations() work on, checked: the problem, the pool (from
+  // kParallelMinimum observations on), the knots, the observations in
+  // covariate order (ties by input position).
+  struct Prepared {
+    Problem<Scalar> problem;
+    std::optional<ChunkPool> pool;
+    Knots knots;
+    std::vector<std::size_t> order;
+  };
+
+  template <class Observations, class Covariates>
+  std::optional<Rejection> prepare(const Observations& observations, const Covariates& covariates,
+                                   const std::vector<Scalar>& weights,
+                                   const std::vector<Element>* start, Prepared& out) const;
+
   template <class Observations, class Covariates>
   Result run(const Observations& observations, const Covariates& covariates,
              const std::vector<Scalar>& weights, const std::vector<Element>* start) const;
@@ -523,55 +576,68 @@ class SplineRegression {
 
 template <class G>
 template <class Observations, class Covariates>
-typename SplineRegression<G>::Result SplineRegression<G>::run(
-    const Observations& observations, const Covariates& covariates,
-    const std::vector<Scalar>& weights, const std::vector<Element>* start) const {
-  // 1. The problem, the knots, Schoenberg-Whitney.
-  if (auto rejection = validate()) return rejected(*rejection);
+std::optional<Rejection> SplineRegression<G>::prepare(const Observations& observations,
+                                                      const Covariates& covariates,
+                                                      const std::vector<Scalar>& weights,
+                                                      const std::vector<Element>* start,
+                                                      Prepared& out) const {
+  if (auto rejection = validate()) return rejection;
   const std::size_t n = observations.size();
   if (covariates.size() != n) {
-    return rejected({"observations and covariates differ in length (" + std::to_string(n) + " vs " +
-                     std::to_string(covariates.size()) + ")"});
+    return Rejection{"observations and covariates differ in length (" + std::to_string(n) + " vs " +
+                     std::to_string(covariates.size()) + ")"};
   }
-  if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
-  Problem<Scalar> problem;
-  if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
-    return rejected(*rejection);
+  if (n < 2) return Rejection{"need at least 2 observations, got " + std::to_string(n)};
+  if (auto rejection = make_problem(covariates, weights, options_.interval, out.problem)) {
+    return rejection;
   }
-  // The pool lives as long as this fit; below kParallelMinimum there is none.
-  std::optional<ChunkPool> pool;
-  if (options_.threads > 1 && n >= kParallelMinimum) pool.emplace(options_.threads, chunk_count(n));
-  ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
-  if (auto rejection =
-          check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
-    return rejected(*rejection);
+  if (options_.threads > 1 && n >= kParallelMinimum) {
+    out.pool.emplace(options_.threads, chunk_count(n));
   }
-  Knots knots;
-  if (auto rejection = make_knots(problem, knots)) return rejected(*rejection);
-  // The observations by covariate (ties by input position), for the
-  // Schoenberg-Whitney check and the start.
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return problem.t[a] < problem.t[b]; });
-  if (auto rejection = check_schoenberg_whitney(problem, order, knots)) {
-    return rejected(*rejection);
+  if (auto rejection = check_observations<G>(observations, options_.element_tolerance,
+                                             out.pool ? &*out.pool : nullptr)) {
+    return rejection;
+  }
+  if (auto rejection = make_knots(out.problem, out.knots)) return rejection;
+  out.order.resize(n);
+  std::iota(out.order.begin(), out.order.end(), std::size_t(0));
+  const std::vector<Scalar>& t = out.problem.t;
+  std::stable_sort(out.order.begin(), out.order.end(),
+                   [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+  if (auto rejection = check_schoenberg_whitney(out.problem, out.order, out.knots)) {
+    return rejection;
   }
   if (start) {
-    if (start->size() != knots.control_points) {
-      return rejected({"the start has " + std::to_string(start->size()) +
-                       " control points; the knots need " + std::to_string(knots.control_points)});
+    if (start->size() != out.knots.control_points) {
+      return Rejection{"got " + std::to_string(start->size()) + " control points; the knots need " +
+                       std::to_string(out.knots.control_points)};
     }
     for (std::size_t c = 0; c < start->size(); ++c) {
       if (!G::is_element((*start)[c], options_.element_tolerance)) {
-        return rejected(
-            {"start control point " + std::to_string(c) + " is not an element of " + G::name});
+        return Rejection{"control point " + std::to_string(c) + " is not an element of " + G::name};
       }
     }
   }
+  return std::nullopt;
+}
+
+template <class G>
+template <class Observations, class Covariates>
+typename SplineRegression<G>::Result SplineRegression<G>::run(
+    const Observations& observations, const Covariates& covariates,
+    const std::vector<Scalar>& weights, const std::vector<Element>* start) const {
+  // 1. The problem, the knots, Schoenberg-Whitney, the start's size.
+  Prepared prepared;
+  if (auto rejection = prepare(observations, covariates, weights, start, prepared)) {
+    return rejected(*rejection);
+  }
+  const std::size_t n = observations.size();
+  const Problem<Scalar>& problem = prepared.problem;
+  const Knots& knots = prepared.knots;
+  ChunkPool* const chunk_pool = prepared.pool ? &*prepared.pool : nullptr;
 
   // 2. The start.
-  Scratch scratch(problem, knots, std::move(order), options_.degree, chunk_pool);
+  Scratch scratch(problem, knots, std::move(prepared.order), options_.degree, chunk_pool);
   std::vector<Element> points = start ? *start : chart_start(observations, problem, knots, scratch);
 
   // 3. Gauss-Newton with backtracking.
