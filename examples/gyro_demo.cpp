@@ -90,12 +90,24 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   return out;
 }
 
+// One panel of the pictures: the body angular velocity about the sensor's
+// axis k (rad/s) against time.
+bireg_plot::Panel velocity_panel(int k) {
+  const char* axes[] = {"x", "y", "z"};
+  bireg_plot::Panel panel;
+  panel.title = std::string("about the sensor's ") + axes[k] + " axis";
+  panel.x_label = "time";
+  panel.x_unit = "s";
+  panel.y_label = std::string("w") + axes[k];
+  panel.y_unit = "rad/s";
+  return panel;
+}
+
 // The picture: over [from, to] seconds, one panel per axis with the
 // gyroscope, finite differences and bireg (body angular velocity, rad/s).
 bool write_plot_svg(const std::string& path, double from, double to, double noise,
                     const std::vector<double>& t, const std::vector<Vector3>& gyro,
                     const std::vector<Vector3>& differences, const std::vector<Vector3>& smoothed) {
-  const char* axes[] = {"x", "y", "z"};
   bireg_plot::Figure figure;
   figure.title = "x-IMU: body angular velocity from orientation alone, against the gyroscope";
   char subtitle[120];
@@ -115,12 +127,7 @@ bool write_plot_svg(const std::string& path, double from, double to, double nois
         series->y.push_back((*values)[i][k]);
       }
     }
-    bireg_plot::Panel panel;
-    panel.title = std::string("about the sensor's ") + axes[k] + " axis";
-    panel.x_label = "time";
-    panel.x_unit = "s";
-    panel.y_label = std::string("w") + axes[k];
-    panel.y_unit = "rad/s";
+    bireg_plot::Panel panel = velocity_panel(k);
     panel.series = {difference_series, gyro_series, bireg_series};
     figure.panels.push_back(panel);
   }
@@ -173,7 +180,6 @@ std::string spline_cell(const std::vector<SO3::Element>& r, const std::vector<do
 bool write_spline_svg(const std::string& path, double from, double to, double noise,
                       const std::vector<double>& t, const std::vector<Vector3>& gyro,
                       const SplineVelocity& spline) {
-  const char* axes[] = {"x", "y", "z"};
   bireg_plot::Figure figure;
   figure.title =
       "x-IMU: the cubic spline's angular velocity and its 95% band, against the gyroscope";
@@ -195,12 +201,7 @@ bool write_spline_svg(const std::string& path, double from, double to, double no
       band.lower.push_back(spline.velocity[i][k] - spline.half_width[i][k]);
       band.upper.push_back(spline.velocity[i][k] + spline.half_width[i][k]);
     }
-    bireg_plot::Panel panel;
-    panel.title = std::string("about the sensor's ") + axes[k] + " axis";
-    panel.x_label = "time";
-    panel.x_unit = "s";
-    panel.y_label = std::string("w") + axes[k];
-    panel.y_unit = "rad/s";
+    bireg_plot::Panel panel = velocity_panel(k);
     panel.bands = {band};
     panel.series = {gyro_series, spline_series};
     figure.panels.push_back(panel);

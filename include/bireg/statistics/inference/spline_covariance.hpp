@@ -328,37 +328,48 @@ SplineCovariance<G> spline_covariance(const SplineResult<G>& fit, const Observat
   return result;
 }
 
-// Covariance of the fitted pose at covariate t (user units), as the
-// left-trivialised eps with T^(t) = T(t) exp(eps); unbounded for a t that
-// is not finite or an undefined covariance. t outside the knots is the
-// nearer end's, as the curve's value is.
-template <class G>
-typename G::AdMatrix pose_covariance(const SplineCovariance<G>& c, typename G::Scalar t) {
+namespace spline_covariance_detail {
+
+// sum_{j,l} A_j Cov_{jl} A_l^T at t for the maps A_j that `maps_at(segment,
+// maps)` writes; unbounded for a t that is not finite or an undefined
+// covariance.
+template <class G, class MapsAt>
+typename G::AdMatrix pointwise_covariance(const SplineCovariance<G>& c, typename G::Scalar t,
+                                          const MapsAt& maps_at) {
   using AdMatrix = typename G::AdMatrix;
   using std::isfinite;
   if (!c.defined() || !isfinite(t)) return unbounded_covariance<AdMatrix>();
-  spline_covariance_detail::SegmentAt<G> segment;
-  spline_covariance_detail::segment_at(c.spline, t, segment);
-  ControlPointDifferentials<G> differentials;
-  control_point_differentials<G>(c.spline.degree(), segment.basis, segment.product,
-                                 segment.jacobians.data(), differentials);
-  return bounded_or_unbounded<AdMatrix>(spline_covariance_detail::segment_covariance(
-      c, segment.at.segment, differentials.derivative));
+  SegmentAt<G> segment;
+  segment_at(c.spline, t, segment);
+  std::array<AdMatrix, kMaxSplineDegree + 1> maps;
+  maps_at(segment, maps);
+  return bounded_or_unbounded<AdMatrix>(segment_covariance(c, segment.at.segment, maps));
 }
 
-// Covariance of the body velocity at t, per covariate unit squared.
+}  // namespace spline_covariance_detail
+
+// Covariance of the fitted pose at covariate t (user units), as the
+// left-trivialised eps with T^(t) = T(t) exp(eps), through D_c (splines.md
+// (4)); unbounded for a t that is not finite or an undefined covariance.
+// t outside the knots is the nearer end's, as the curve's value is.
+template <class G>
+typename G::AdMatrix pose_covariance(const SplineCovariance<G>& c, typename G::Scalar t) {
+  return spline_covariance_detail::pointwise_covariance(c, t, [&](const auto& segment, auto& maps) {
+    ControlPointDifferentials<G> differentials;
+    control_point_differentials<G>(c.spline.degree(), segment.basis, segment.product,
+                                   segment.jacobians.data(), differentials);
+    maps = differentials.derivative;
+  });
+}
+
+// Covariance of the body velocity at t, per covariate unit squared,
+// through V_c (splines.md (11)).
 template <class G>
 typename G::AdMatrix velocity_covariance(const SplineCovariance<G>& c, typename G::Scalar t) {
-  using AdMatrix = typename G::AdMatrix;
-  using std::isfinite;
-  if (!c.defined() || !isfinite(t)) return unbounded_covariance<AdMatrix>();
-  spline_covariance_detail::SegmentAt<G> segment;
-  spline_covariance_detail::segment_at(c.spline, t, segment);
-  std::array<AdMatrix, kMaxSplineDegree + 1> maps;
-  velocity_differentials<G>(c.spline.degree(), c.spline.knot_spacing(), segment.basis,
-                            segment.product, segment.jacobians.data(), maps);
-  return bounded_or_unbounded<AdMatrix>(
-      spline_covariance_detail::segment_covariance(c, segment.at.segment, maps));
+  return spline_covariance_detail::pointwise_covariance(c, t, [&](const auto& segment, auto& maps) {
+    velocity_differentials<G>(c.spline.degree(), c.spline.knot_spacing(), segment.basis,
+                              segment.product, segment.jacobians.data(), maps);
+  });
 }
 
 // Covariance of a new observation's prediction error at t: the pose's plus S.
