@@ -528,8 +528,10 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
                  name.c_str(), fit.largest_increment_angle, fit.largest_increment - 1,
                  fit.largest_increment);
   }
+  // The standard errors go to the velocity CSV only: no covariance (up to
+  // O((Md)^2) memory and time) unless it is asked for.
   std::optional<bireg::SplineCovariance<G>> covariance;
-  if (fit.ok()) {
+  if (fit.ok() && !command.velocity.empty()) {
     covariance = bireg::spline_covariance(fit, trajectory.observations, trajectory.covariates);
     if (!covariance->defined()) {
       std::fprintf(stderr, "bireg_smooth: %s: no velocity standard errors: %s\n", name.c_str(),
