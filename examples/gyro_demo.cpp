@@ -90,6 +90,15 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   return out;
 }
 
+// Writes `figure` to `path`; false, with a line on stderr, if it cannot.
+bool save_svg(const std::string& path, const bireg_plot::Figure& figure) {
+  std::ofstream out(path);
+  out << bireg_plot::render_svg(figure);
+  out.close();
+  if (!out) std::fprintf(stderr, "gyro_demo: cannot write %s\n", path.c_str());
+  return static_cast<bool>(out);
+}
+
 // One panel of the pictures: the body angular velocity about the sensor's
 // axis k (rad/s) against time.
 bireg_plot::Panel velocity_panel(int k) {
@@ -131,11 +140,7 @@ bool write_plot_svg(const std::string& path, double from, double to, double nois
     panel.series = {difference_series, gyro_series, bireg_series};
     figure.panels.push_back(panel);
   }
-  std::ofstream out(path);
-  out << bireg_plot::render_svg(figure);
-  out.close();
-  if (!out) std::fprintf(stderr, "gyro_demo: cannot write %s\n", path.c_str());
-  return static_cast<bool>(out);
+  return save_svg(path, figure);
 }
 
 // The cubic spline's velocity at the samples and the half-widths of its
@@ -206,11 +211,7 @@ bool write_spline_svg(const std::string& path, double from, double to, double no
     panel.series = {gyro_series, spline_series};
     figure.panels.push_back(panel);
   }
-  std::ofstream out(path);
-  out << bireg_plot::render_svg(figure);
-  out.close();
-  if (!out) std::fprintf(stderr, "gyro_demo: cannot write %s\n", path.c_str());
-  return static_cast<bool>(out);
+  return save_svg(path, figure);
 }
 
 // The fraction of samples whose reference lies inside the band on every axis.
