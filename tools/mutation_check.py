@@ -84,8 +84,8 @@ MUTANTS = [
            ["test_regression"],
            "weights dropped from the Q moments of the series force"),
     Mutant("GN1", "include/bireg/regression/step_rules/gauss_newton.hpp",
-           "matrix(state.a).partialPivLu().solve(v);",
-           "matrix(state.a).partialPivLu().solve(-v);",
+           "SmallLU<KMatrix>(matrix(state.a)).solve(v);",
+           "SmallLU<KMatrix>(matrix(state.a)).solve(-v);",
            ["test_regression"],
            "sign flip of the Gauss-Newton step"),
     Mutant("IT1", "include/bireg/regression/iteration.hpp",
@@ -203,6 +203,16 @@ MUTANTS = [
            "c.block(segment + std::size_t(j), segment + std::size_t(l)) *\n                       maps[std::size_t(j)].transpose();",
            ["test_spline_inference"],
            "a pointwise covariance with one control point's map on both sides"),
+    Mutant("SD1", "include/bireg/math/symmetric_eigen.hpp",
+           "v[at(k, q)] = s * vkp + c * vkq;",
+           "v[at(k, q)] = s * vkp - c * vkq;",
+           ["test_small_dense"],
+           "an eigenvector rotation with the wrong sign (vectors no longer orthogonal)"),
+    Mutant("SD2", "include/bireg/math/small_lu.hpp",
+           "if (pivot[k] != k) std::swap(x[k], x[pivot[k]]);",
+           "if (pivot[k] == k) std::swap(x[k], x[pivot[k]]);",
+           ["test_small_dense"],
+           "the right-hand side not permuted like the rows: a wrong solve whenever LU pivots"),
 ]
 
 

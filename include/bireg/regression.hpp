@@ -139,18 +139,6 @@ class GeodesicRegression {
     }
   }
 
-  // K at the returned endpoints: from the Gauss-Newton rule's coefficients
-  // when that rule ran, otherwise built once here (O(N)).
-  template <class Rule>
-  static typename Result::Jacobian jacobian_at(const Rule& rule, const Problem<Scalar>& problem,
-                                               const State<G>& state) {
-    if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
-      return rule.matrix(state.a);
-    } else {
-      return GaussNewtonStep<G>(problem, Scalar(0)).matrix(state.a);
-    }
-  }
-
   Options options_;
 };
 
@@ -204,11 +192,9 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
   }
   const Endpoints first = start ? *start : Endpoints(chart.g0, chart.g1);
 
-  // 3. The iteration, with the chosen step rule; 4. the diagnostics.
-  return with_step_rule<G>(options_.solver, [&](auto tag) {
-    using Rule = typename decltype(tag)::type;
-    if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
-    const Rule rule = make_rule<Rule>(problem, chunk_pool);
+  // 3. The iteration, with the chosen step rule (compiled once for every
+  // rule, through its view); 4. the diagnostics.
+  const auto iterate_and_diagnose = [&](const StepRuleView<G>& rule) {
     const PsiEvaluation psi = options_.psi();
     const IterationControl<Scalar> control{options_.tolerance, options_.max_iterations,
                                            options_.record_iterates};
@@ -231,8 +217,10 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
       for (std::size_t i = 0; i < n; ++i) {
         result.residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
       }
-    } else {
-      result.jacobian = jacobian_at(rule, problem, state);
+    } else {  // K at the endpoints: the Gauss-Newton rule's, or built here (O(N))
+      result.jacobian = rule.gauss_newton()
+                            ? rule.gauss_newton()->matrix(state.a)
+                            : GaussNewtonStep<G>(problem, Scalar(0)).matrix(state.a);
     }
     result.status = record.status;
     result.iterations = record.iterations;
@@ -243,6 +231,12 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
     result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
                                   static_cast<Scalar>(problem.t_max));
     return result;
+  };
+  return with_step_rule<G>(options_.solver, [&](auto tag) {
+    using Rule = typename decltype(tag)::type;
+    if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
+    const Rule rule = make_rule<Rule>(problem, chunk_pool);
+    return iterate_and_diagnose(StepRuleView<G>(rule));
   });
 }
 

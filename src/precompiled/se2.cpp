@@ -32,7 +32,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SE2d>&, d
 template FitCovariance<SE2d> covariance(const RegressionResult<SE2d>&, const std::vector<double>&,
                                         const std::vector<double>&, CovarianceFlavour);
 template FitCovariance<SE2d> covariance_of(const Geodesic<SE2d>&, const std::vector<SE2d::Tangent>&,
-                                           const Problem<double>&, CovarianceFlavour, bool);
+                                           const Problem<double>&, CovarianceFlavour);
 
 template ExplainedVariance<double> explained_variance(const RegressionResult<SE2d>&,
                                                       const MeanResult<SE2d>&,
@@ -62,7 +62,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SE2f>&, d
 template FitCovariance<SE2f> covariance(const RegressionResult<SE2f>&, const std::vector<double>&,
                                         const std::vector<float>&, CovarianceFlavour);
 template FitCovariance<SE2f> covariance_of(const Geodesic<SE2f>&, const std::vector<SE2f::Tangent>&,
-                                           const Problem<float>&, CovarianceFlavour, bool);
+                                           const Problem<float>&, CovarianceFlavour);
 
 template ExplainedVariance<float> explained_variance(const RegressionResult<SE2f>&,
                                                      const MeanResult<SE2f>&,

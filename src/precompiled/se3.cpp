@@ -32,7 +32,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SE3d>&, d
 template FitCovariance<SE3d> covariance(const RegressionResult<SE3d>&, const std::vector<double>&,
                                         const std::vector<double>&, CovarianceFlavour);
 template FitCovariance<SE3d> covariance_of(const Geodesic<SE3d>&, const std::vector<SE3d::Tangent>&,
-                                           const Problem<double>&, CovarianceFlavour, bool);
+                                           const Problem<double>&, CovarianceFlavour);
 
 template ExplainedVariance<double> explained_variance(const RegressionResult<SE3d>&,
                                                       const MeanResult<SE3d>&,
@@ -62,7 +62,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SE3f>&, d
 template FitCovariance<SE3f> covariance(const RegressionResult<SE3f>&, const std::vector<double>&,
                                         const std::vector<float>&, CovarianceFlavour);
 template FitCovariance<SE3f> covariance_of(const Geodesic<SE3f>&, const std::vector<SE3f::Tangent>&,
-                                           const Problem<float>&, CovarianceFlavour, bool);
+                                           const Problem<float>&, CovarianceFlavour);
 
 template ExplainedVariance<float> explained_variance(const RegressionResult<SE3f>&,
                                                      const MeanResult<SE3f>&,

@@ -33,7 +33,7 @@ template FitCovariance<Sim3d> covariance(const RegressionResult<Sim3d>&, const s
                                          const std::vector<double>&, CovarianceFlavour);
 template FitCovariance<Sim3d> covariance_of(const Geodesic<Sim3d>&,
                                             const std::vector<Sim3d::Tangent>&,
-                                            const Problem<double>&, CovarianceFlavour, bool);
+                                            const Problem<double>&, CovarianceFlavour);
 
 template ExplainedVariance<double> explained_variance(const RegressionResult<Sim3d>&,
                                                       const MeanResult<Sim3d>&,
@@ -64,7 +64,7 @@ template FitCovariance<Sim3f> covariance(const RegressionResult<Sim3f>&, const s
                                          const std::vector<float>&, CovarianceFlavour);
 template FitCovariance<Sim3f> covariance_of(const Geodesic<Sim3f>&,
                                             const std::vector<Sim3f::Tangent>&,
-                                            const Problem<float>&, CovarianceFlavour, bool);
+                                            const Problem<float>&, CovarianceFlavour);
 
 template ExplainedVariance<float> explained_variance(const RegressionResult<Sim3f>&,
                                                      const MeanResult<Sim3f>&,

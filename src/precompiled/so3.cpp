@@ -32,7 +32,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SO3d>&, d
 template FitCovariance<SO3d> covariance(const RegressionResult<SO3d>&, const std::vector<double>&,
                                         const std::vector<double>&, CovarianceFlavour);
 template FitCovariance<SO3d> covariance_of(const Geodesic<SO3d>&, const std::vector<SO3d::Tangent>&,
-                                           const Problem<double>&, CovarianceFlavour, bool);
+                                           const Problem<double>&, CovarianceFlavour);
 
 template ExplainedVariance<double> explained_variance(const RegressionResult<SO3d>&,
                                                       const MeanResult<SO3d>&,
@@ -62,7 +62,7 @@ template std::optional<double> prediction_quantile(const FitCovariance<SO3f>&, d
 template FitCovariance<SO3f> covariance(const RegressionResult<SO3f>&, const std::vector<double>&,
                                         const std::vector<float>&, CovarianceFlavour);
 template FitCovariance<SO3f> covariance_of(const Geodesic<SO3f>&, const std::vector<SO3f::Tangent>&,
-                                           const Problem<float>&, CovarianceFlavour, bool);
+                                           const Problem<float>&, CovarianceFlavour);
 
 template ExplainedVariance<float> explained_variance(const RegressionResult<SO3f>&,
                                                      const MeanResult<SO3f>&,

@@ -214,7 +214,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
     State<G> next = evaluate<G>(observations, problem, psi, exp_at<G>(state.g0, d0),
                                 exp_at<G>(state.g1, d1), trial_residuals, workspace);
     full_step = step_norm;
-    if constexpr (Rule::safeguarded) {
+    if (rule.safeguarded) {
       const Scalar force_norm = state.force.norm();
       const auto acceptable = [&](const State<G>& trial) {
         return trial.series_converges && trial.force.norm() <= force_norm;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <type_traits>
+#include <utility>
 
 #include "bireg/regression/step_rules/gauss_newton.hpp"
 #include "bireg/regression/step_rules/optimal_linear.hpp"
@@ -58,5 +59,53 @@ auto with_step_rule(Solver solver, Visitor&& visit) {
   }
   return visit(StepRuleTag<GaussNewtonStep<G>>{});
 }
+
+// A reference to one step rule, whichever it is. The code that runs a
+// rule (iterate, the diagnostics, each caller's bookkeeping) takes the
+// view and is compiled once instead of once per rule: with_step_rule's
+// visitor builds the rule and hands its view on. Each rule's own code
+// stays in its type; the view costs one indirect call per iteration.
+template <class G>
+class StepRuleView {
+ public:
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+
+  // `rule` must outlive the view.
+  template <class Rule>
+  explicit StepRuleView(const Rule& rule)
+      : safeguarded(Rule::safeguarded),
+        rule_(&rule),
+        step_([](const void* r, const State<G>& state) {
+          return (*static_cast<const Rule*>(r))(state);
+        }),
+        convergence_norm_([](const void* r, Scalar step_norm, const State<G>& state) {
+          return static_cast<const Rule*>(r)->convergence_norm(step_norm, state);
+        }),
+        step_size_(rule.step_size()) {
+    if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) gauss_newton_ = &rule;
+  }
+
+  std::pair<Tangent, Tangent> operator()(const State<G>& state) const {
+    return step_(rule_, state);
+  }
+  Scalar convergence_norm(Scalar step_norm, const State<G>& state) const {
+    return convergence_norm_(rule_, step_norm, state);
+  }
+  Scalar step_size() const { return step_size_; }
+  // The rule when it is the Gauss-Newton one (its K at the estimate is the
+  // covariance's), else null.
+  const GaussNewtonStep<G>* gauss_newton() const { return gauss_newton_; }
+
+  // As each rule's static member (iteration.hpp reads rule.safeguarded).
+  const bool safeguarded;
+
+ private:
+  const void* rule_;
+  std::pair<Tangent, Tangent> (*step_)(const void*, const State<G>&);
+  Scalar (*convergence_norm_)(const void*, Scalar, const State<G>&);
+  Scalar step_size_;
+  const GaussNewtonStep<G>* gauss_newton_ = nullptr;
+};
 
 }  // namespace bireg

@@ -14,7 +14,8 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
+
+#include "bireg/math/small_lu.hpp"
 
 namespace bireg {
 
@@ -48,15 +49,13 @@ class BlockBandedMatrix {
 
   // The block LU of K, kept for substitute(): false when a pivot is
   // singular to working precision (U's diagonal within a pivot spans more
-  // than 1/eps, a cheap stand-in for the condition number).
+  // than 1/(d eps), a cheap stand-in for the condition number).
   bool factorize() {
     work_ = blocks_;
     factored_ = false;
-    const Scalar tiny = std::numeric_limits<Scalar>::epsilon();
     for (std::size_t c = 0; c < rows_; ++c) {
-      const Eigen::PartialPivLU<Block> pivot(at(c, c));
-      const auto diagonal = pivot.matrixLU().diagonal().cwiseAbs();
-      if (!(diagonal.minCoeff() > tiny * diagonal.maxCoeff())) return false;
+      const SmallLU<Block> pivot(at(c, c));
+      if (!pivot.invertible()) return false;
       pivot_inverse_[c] = pivot.inverse();
       const std::size_t last = std::min(rows_ - 1, c + band_);
       for (std::size_t r = c + 1; r <= last; ++r) {

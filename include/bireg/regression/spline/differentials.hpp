@@ -26,9 +26,9 @@
 #include <array>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/math/small_lu.hpp"
 #include "bireg/spline.hpp"
 
 namespace bireg {
@@ -92,7 +92,7 @@ void control_point_differentials(int degree, const SplineBasis<typename G::Scala
   out.weight[0] =
       b[0] * (first.left * right_jacobian_inverse<G>(anchor_scaled)) * G::Ad(product.suffix[1]);
   for (int j = 1; j < k; ++j)
-    out.weight[j] = (b[j] * b[j]) * out.derivative[j].inverse();
+    out.weight[j] = (b[j] * b[j]) * SmallLU<AdMatrix>(out.derivative[j]).inverse();
   out.weight[k] = b[k] * (jacobians[k - 1].right * last_inverse);
 }
 

@@ -29,9 +29,9 @@
 #include <utility>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "bireg/math/psi_series.hpp"
+#include "bireg/math/small_lu.hpp"
 #include "bireg/regression/estimating_equations.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
@@ -138,7 +138,7 @@ class GaussNewtonStep {
     KVector v;
     v.template head<d>() = state.force.v0;
     v.template tail<d>() = state.force.v1;
-    const KVector delta = matrix(state.a).partialPivLu().solve(v);
+    const KVector delta = SmallLU<KMatrix>(matrix(state.a)).solve(v);
     return {delta.template head<d>(), delta.template tail<d>()};
   }
 

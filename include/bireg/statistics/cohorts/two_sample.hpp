@@ -39,11 +39,12 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
 #include "bireg/concept.hpp"
+#include "bireg/math/small_lu.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/status.hpp"
 #include "bireg/statistics/inference/mean.hpp"
@@ -169,9 +170,7 @@ constexpr Scalar kSingular = Scalar(1e-12);
 template <class Matrix>
 std::optional<typename Matrix::Scalar> log_determinant(const Matrix& s) {
   using Scalar = typename Matrix::Scalar;
-  const Eigen::SelfAdjointEigenSolver<Matrix> eigen(s, Eigen::EigenvaluesOnly);
-  if (eigen.info() != Eigen::Success) return std::nullopt;
-  const auto& lambda = eigen.eigenvalues();  // ascending
+  const auto lambda = symmetric_eigen(s).values;  // ascending; NaN if s is not finite
   const Scalar largest = lambda[lambda.size() - 1];
   if (!(largest > 0) || !(lambda[0] > kSingular<Scalar> * largest)) return std::nullopt;
   return lambda.array().log().sum();
@@ -244,7 +243,7 @@ bool split_mean(const Pooled<G>& pooled, const std::size_t* index, std::size_t c
     force += pooled.z[index[i]];
     jacobian += pooled.jacobian[index[i]];
   }
-  const Eigen::PartialPivLU<AdMatrix> chord(jacobian);
+  const SmallLU<AdMatrix> chord(jacobian);
   Tangent step = chord.solve(force);
   if (!step.allFinite()) return false;
   mean = G::compose(pooled.mean, G::exp(step));

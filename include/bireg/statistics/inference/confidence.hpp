@@ -42,10 +42,10 @@
 #include <optional>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
 #include "bireg/statistics/inference/distributions.hpp"
 #include "bireg/statistics/inference/scatter.hpp"
@@ -74,7 +74,7 @@ template <class G>
 EndpointMap<G> pose_map(const typename G::Tangent& x, typename G::Scalar s) {
   using Tangent = typename G::Tangent;
   const typename G::AdMatrix carry = s * right_jacobian<G>(Tangent(s * x));
-  EndpointMap<G> map = carry * displacement_map<G>(x);
+  EndpointMap<G> map = carry.lazyProduct(displacement_map<G>(x));
   map.template leftCols<G::dof>() += G::Ad(G::exp(Tangent(-s * x)));
   return map;
 }
@@ -99,9 +99,12 @@ Matrix bounded_or_unbounded(const Matrix& c) {
 // squared.
 template <class G>
 typename G::AdMatrix velocity_covariance(const FitCovariance<G>& c) {
-  const EndpointMap<G> spread = displacement_map<G>(c.geodesic.displacement()) * c.factor;
+  // Lazy products: see covariance.hpp's satterthwaite.
+  const EndpointMap<G> spread =
+      displacement_map<G>(c.geodesic.displacement()).lazyProduct(c.factor);
   const typename G::Scalar range = c.geodesic.t_max() - c.geodesic.t_min();
-  return bounded_or_unbounded<typename G::AdMatrix>(spread * spread.transpose() / (range * range));
+  return bounded_or_unbounded<typename G::AdMatrix>(spread.lazyProduct(spread.transpose()) /
+                                                    (range * range));
 }
 
 // Covariance of the fitted pose at covariate t (user units), as the
@@ -111,8 +114,8 @@ typename G::AdMatrix pose_covariance(const FitCovariance<G>& c, typename G::Scal
   using std::isfinite;
   const typename G::Scalar s = c.geodesic.normalized(t);
   if (!isfinite(s)) return unbounded_covariance<typename G::AdMatrix>();
-  const EndpointMap<G> spread = pose_map<G>(c.geodesic.displacement(), s) * c.factor;
-  return bounded_or_unbounded<typename G::AdMatrix>(spread * spread.transpose());
+  const EndpointMap<G> spread = pose_map<G>(c.geodesic.displacement(), s).lazyProduct(c.factor);
+  return bounded_or_unbounded<typename G::AdMatrix>(spread.lazyProduct(spread.transpose()));
 }
 
 // Covariance of the prediction error of a new observation at t.
@@ -150,10 +153,10 @@ template <class Matrix, class Vector>
 typename Matrix::Scalar mahalanobis_squared(const Matrix& c, const Vector& v) {
   using Scalar = typename Matrix::Scalar;
   if (!c.allFinite() || !v.allFinite()) return std::numeric_limits<Scalar>::infinity();
-  const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
-  const auto& values = solver.eigenvalues();
+  const auto eigen = symmetric_eigen(c);
+  const auto& values = eigen.values;
   const Scalar largest = values[values.size() - 1];
-  const auto coordinates = (solver.eigenvectors().transpose() * v).eval();
+  const auto coordinates = (eigen.vectors.transpose() * v).eval();
   Scalar sum = 0;
   for (int k = 0; k < values.size(); ++k) {
     if (largest > 0 && values[k] > Scalar(kRangeTolerance) * largest) {

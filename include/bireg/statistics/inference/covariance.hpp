@@ -92,13 +92,14 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/capabilities.hpp"
 #include "bireg/math/ad_algebra.hpp"
+#include "bireg/math/small_lu.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/result.hpp"
 
@@ -178,9 +179,9 @@ FitCovariance<G> refused(CovarianceStatus status, std::string message) {
 // A square root L of a symmetric positive semi-definite S (S = L L^T).
 template <class Matrix>
 Matrix square_root(const Matrix& s) {
-  const Eigen::SelfAdjointEigenSolver<Matrix> solver(s);
-  const auto root = solver.eigenvalues().cwiseMax(typename Matrix::Scalar(0)).cwiseSqrt();
-  return solver.eigenvectors() * root.asDiagonal();
+  const auto eigen = symmetric_eigen(s);
+  const auto root = eigen.values.cwiseMax(typename Matrix::Scalar(0)).cwiseSqrt();
+  return eigen.vectors * root.asDiagonal();
 }
 
 // nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = map
@@ -195,10 +196,13 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
   constexpr int p = Map::RowsAtCompileTime;
   using Matrix = Eigen::Matrix<Scalar, p, p>;
   using Vector = Eigen::Matrix<Scalar, p, 1>;
-  const Map spread = map * meat_root;
-  const Matrix c = spread * spread.transpose();
-  const Eigen::SelfAdjointEigenSolver<Matrix> solver(c);
-  const Vector values = solver.eigenvalues();
+  // Products of 2d-sized matrices are lazy (coefficient-wise) throughout:
+  // Eigen's blocked product kernels cost seconds of compile time per shape
+  // and win nothing at these sizes.
+  const Map spread = map.lazyProduct(meat_root);
+  const Matrix c = spread.lazyProduct(spread.transpose());
+  const SymmetricEigen<Scalar, p> eigen = symmetric_eigen(c);
+  const Vector& values = eigen.values;
   const Scalar largest = values[p - 1];
   Vector inverse_root = Vector::Zero();
   int rank = 0;
@@ -208,7 +212,7 @@ typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& for
       ++rank;
     }
   }
-  const Map whitening = inverse_root.asDiagonal() * solver.eigenvectors().transpose() * map;
+  const Map whitening = inverse_root.asDiagonal() * eigen.vectors.transpose().lazyProduct(map);
   Scalar sum = 0;
   for (const Force& f : forces) {
     const Scalar kappa = whitening.lazyProduct(f).squaredNorm();
@@ -392,15 +396,17 @@ ObservationSums<G> sums_by_algebra(const PassInputs<G>& in,
 // weights), from the residuals at those endpoints in the problem's order.
 // For callers that hold the problem already (the local regression, one
 // fit per window): the homoscedastic flavour allocates nothing, except the
-// message of a refusal. `matrix_pass` forces the pass with d x d matrices
-// per observation where the group has the algebra of ad_X (for tests; the
-// two agree to rounding).
-template <class G>
+// message of a refusal. CovariancePass::matrices forces the pass with
+// d x d matrices per observation where the group has the algebra of ad_X
+// (for tests; the two agree to rounding). A template argument, not a run-time
+// flag, so that a caller compiles only the pass it runs.
+enum class CovariancePass { fastest, matrices };
+
+template <class G, CovariancePass Pass = CovariancePass::fastest>
 FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
                                const std::vector<typename G::Tangent>& residuals,
                                const Problem<typename G::Scalar>& problem,
-                               CovarianceFlavour flavour = CovarianceFlavour::homoscedastic,
-                               bool matrix_pass = false) {
+                               CovarianceFlavour flavour = CovarianceFlavour::homoscedastic) {
   static_assert(check_lie_group<G>());
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
@@ -474,9 +480,9 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   const covariance_detail::PassInputs<G> inputs{x, h_inverse, leverage_matrix,
                                                 covariance_detail::square_root(s), flavour};
   covariance_detail::ObservationSums<G> sums;
-  if constexpr (provides_v<G, capability_detail::ad_algebra_basis>) {
-    sums = matrix_pass ? covariance_detail::sums_by_matrices(inputs, problem, residuals)
-                       : covariance_detail::sums_by_algebra(inputs, problem, residuals);
+  if constexpr (Pass == CovariancePass::fastest &&
+                provides_v<G, capability_detail::ad_algebra_basis>) {
+    sums = covariance_detail::sums_by_algebra(inputs, problem, residuals);
   } else {
     sums = covariance_detail::sums_by_matrices(inputs, problem, residuals);
   }
@@ -505,8 +511,8 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   EndpointMatrix outer = EndpointMatrix::Zero();
   outer.template topLeftCorner<d, d>() = jacobian_back;
   outer.template bottomRightCorner<d, d>() = jacobian_forward;
-  const Eigen::FullPivLU<EndpointMatrix> k_lu(k);
-  if (!k_lu.isInvertible()) {
+  const SmallLU<EndpointMatrix> k_lu(k);
+  if (!k_lu.invertible()) {
     return refused<G>(CovarianceStatus::undefined, "K is singular at the estimate");
   }
   const EndpointMatrix bread = k_lu.solve(outer);
@@ -518,8 +524,8 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   // and cancel (a fuzzer found an eigenvalue of -5% of the largest on an
   // SE(3) fit of poses 1e16 m apart).
   const EndpointMatrix meat_root = covariance_detail::square_root(meat);
-  const EndpointMatrix factor = bread * meat_root;
-  EndpointMatrix c = factor * factor.transpose();
+  const EndpointMatrix factor = bread.lazyProduct(meat_root);
+  EndpointMatrix c = factor.lazyProduct(factor.transpose());
   c = ((c + c.transpose()) / 2).eval();
   if (!c.allFinite()) {
     return refused<G>(CovarianceStatus::undefined, "the covariance is not finite");
@@ -537,11 +543,11 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
     result.effective.endpoints =
         covariance_detail::satterthwaite(EndpointMatrix(bread), sums.forces, meat_root);
     result.effective.start = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(start_map * bread), sums.forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(start_map.lazyProduct(bread)), sums.forces, meat_root);
     result.effective.end = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(end_map * bread), sums.forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(end_map.lazyProduct(bread)), sums.forces, meat_root);
     result.effective.velocity = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map * bread), sums.forces, meat_root);
+        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map.lazyProduct(bread)), sums.forces, meat_root);
     // Zero degrees of freedom: the quantity's robust covariance is zero,
     // every observation that bears on it fitting exactly (two identical
     // observations at t_min pin the start, whatever the others do).

@@ -45,11 +45,10 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/LU>
-
 #include "bireg/concept.hpp"
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/small_lu.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/status.hpp"
 
@@ -190,7 +189,7 @@ MeanResult<G> mean(const Observations& observations,
   result.status = Status::max_iterations;
   result.step_norms.reserve(static_cast<std::size_t>(options.max_iterations));
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    const Tangent step = options.newton ? Tangent(jacobian.partialPivLu().solve(force)) : force;
+    const Tangent step = options.newton ? Tangent(SmallLU<AdMatrix>(jacobian).solve(force)) : force;
     const Scalar step_norm = sqrt(step.squaredNorm());
     result.iterations = iteration + 1;
     using std::isfinite;

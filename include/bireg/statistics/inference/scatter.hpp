@@ -25,8 +25,9 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
+
+#include "bireg/math/small_lu.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 
 namespace bireg {
 
@@ -54,14 +55,14 @@ class ScatterRange {
   using Basis = Eigen::Matrix<Scalar, D, Eigen::Dynamic, 0, D, D>;  // fixed capacity: no heap
 
   explicit ScatterRange(const Matrix& reference) {
-    const Eigen::SelfAdjointEigenSolver<Matrix> solver(reference);
-    const auto& values = solver.eigenvalues();  // ascending
+    const SymmetricEigen<Scalar, D> eigen = symmetric_eigen(reference);
+    const auto& values = eigen.values;  // ascending
     const Scalar largest = values[D - 1];
     int rank = 0;
     for (int k = 0; k < D; ++k)
       if (largest > 0 && values[k] > Scalar(kRangeTolerance) * largest) ++rank;
     rank_ = rank;
-    basis_ = solver.eigenvectors().rightCols(rank);
+    basis_ = eigen.vectors.rightCols(rank);
     reference_log_determinant_ = 0;
     for (int k = D - rank; k < D; ++k)
       reference_log_determinant_ += std::log(values[k]);
@@ -73,9 +74,11 @@ class ScatterRange {
   // det(U^T s U) / det(U^T reference U); 0 when the range is empty.
   Scalar ratio(const Matrix& s) const {
     if (rank_ == 0) return Scalar(0);
-    const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, 0, D, D> projected =
-        basis_.transpose() * s * basis_;
-    const Scalar determinant = projected.determinant();
+    using Projected = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, 0, D, D>;
+    // Lazy products and SmallLU: Eigen's dynamic-size kernels would cost
+    // seconds of compile time in every user of this header.
+    const Projected projected = basis_.transpose().lazyProduct(s.lazyProduct(basis_));
+    const Scalar determinant = SmallLU<Projected>(projected).determinant();
     if (!(determinant > 0)) return Scalar(0);
     return std::exp(std::log(determinant) - reference_log_determinant_);
   }

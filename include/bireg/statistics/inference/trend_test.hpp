@@ -311,24 +311,28 @@ TrendTestResult<G> trend_test(const GeodesicRegression<G>& regression,
       buffers.permuted[i] = static_cast<Wide>(covariates[buffers.order[i]]);
     const Problem<Scalar>& problem = buffers.problem;
     if (!make_problem(buffers.permuted, weights, permuted_options.interval, buffers.problem)) {
+      // Compiled once for every step rule, through its view.
+      const auto permuted_fit = [&](const StepRuleView<G>& rule) -> std::optional<Verdict> {
+        const PsiEvaluation psi = permuted_options.psi();
+        const IterationControl<Scalar> control{permuted_options.tolerance,
+                                               permuted_options.max_iterations, false};
+        const Endpoints first =
+            options.start == PermutationStart::chart ? chart.line(problem) : fixed_start;
+        trend_detail::LambdaDecision<Scalar, d> decision(range, weights, threshold,
+                                                         options.decide_early);
+        iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
+                   observations[middle_observation(problem)], buffers.residuals, buffers.record,
+                   &buffers.workspace, decision);
+        if (buffers.record.decided) return decision.verdict();
+        if (!is_success(buffers.record.status)) return std::nullopt;
+        return verdict_at(buffers.residuals);
+      };
       const std::optional<Verdict> verdict =
           with_step_rule<G>(permuted_options.solver, [&](auto tag) -> std::optional<Verdict> {
             using Rule = typename decltype(tag)::type;
             if (Rule::refuse(problem, permuted_options.step_size)) return std::nullopt;
             const Rule rule(problem, permuted_options.step_size);
-            const PsiEvaluation psi = permuted_options.psi();
-            const IterationControl<Scalar> control{permuted_options.tolerance,
-                                                   permuted_options.max_iterations, false};
-            const Endpoints first =
-                options.start == PermutationStart::chart ? chart.line(problem) : fixed_start;
-            trend_detail::LambdaDecision<Scalar, d> decision(range, weights, threshold,
-                                                             options.decide_early);
-            iterate<G>(observations, problem, psi, rule, control, first.first, first.second,
-                       observations[middle_observation(problem)], buffers.residuals, buffers.record,
-                       &buffers.workspace, decision);
-            if (buffers.record.decided) return decision.verdict();
-            if (!is_success(buffers.record.status)) return std::nullopt;
-            return verdict_at(buffers.residuals);
+            return permuted_fit(StepRuleView<G>(rule));
           });
       if (verdict) return *verdict;
     }

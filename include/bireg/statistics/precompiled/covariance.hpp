@@ -22,7 +22,7 @@ extern template FitCovariance<SO3d> covariance(const RegressionResult<SO3d>&,
                                                const std::vector<double>&, CovarianceFlavour);
 extern template FitCovariance<SO3d> covariance_of(const Geodesic<SO3d>&,
                                                   const std::vector<SO3d::Tangent>&,
-                                                  const Problem<double>&, CovarianceFlavour, bool);
+                                                  const Problem<double>&, CovarianceFlavour);
 
 // SE(3), double
 extern template FitCovariance<SE3d> covariance(const RegressionResult<SE3d>&,
@@ -30,7 +30,7 @@ extern template FitCovariance<SE3d> covariance(const RegressionResult<SE3d>&,
                                                const std::vector<double>&, CovarianceFlavour);
 extern template FitCovariance<SE3d> covariance_of(const Geodesic<SE3d>&,
                                                   const std::vector<SE3d::Tangent>&,
-                                                  const Problem<double>&, CovarianceFlavour, bool);
+                                                  const Problem<double>&, CovarianceFlavour);
 
 // SE(2), double
 extern template FitCovariance<SE2d> covariance(const RegressionResult<SE2d>&,
@@ -38,7 +38,7 @@ extern template FitCovariance<SE2d> covariance(const RegressionResult<SE2d>&,
                                                const std::vector<double>&, CovarianceFlavour);
 extern template FitCovariance<SE2d> covariance_of(const Geodesic<SE2d>&,
                                                   const std::vector<SE2d::Tangent>&,
-                                                  const Problem<double>&, CovarianceFlavour, bool);
+                                                  const Problem<double>&, CovarianceFlavour);
 
 // Sim(3), double
 extern template FitCovariance<Sim3d> covariance(const RegressionResult<Sim3d>&,
@@ -46,7 +46,7 @@ extern template FitCovariance<Sim3d> covariance(const RegressionResult<Sim3d>&,
                                                 const std::vector<double>&, CovarianceFlavour);
 extern template FitCovariance<Sim3d> covariance_of(const Geodesic<Sim3d>&,
                                                    const std::vector<Sim3d::Tangent>&,
-                                                   const Problem<double>&, CovarianceFlavour, bool);
+                                                   const Problem<double>&, CovarianceFlavour);
 
 // SO(3), float
 extern template FitCovariance<SO3f> covariance(const RegressionResult<SO3f>&,
@@ -54,7 +54,7 @@ extern template FitCovariance<SO3f> covariance(const RegressionResult<SO3f>&,
                                                const std::vector<float>&, CovarianceFlavour);
 extern template FitCovariance<SO3f> covariance_of(const Geodesic<SO3f>&,
                                                   const std::vector<SO3f::Tangent>&,
-                                                  const Problem<float>&, CovarianceFlavour, bool);
+                                                  const Problem<float>&, CovarianceFlavour);
 
 // SE(3), float
 extern template FitCovariance<SE3f> covariance(const RegressionResult<SE3f>&,
@@ -62,7 +62,7 @@ extern template FitCovariance<SE3f> covariance(const RegressionResult<SE3f>&,
                                                const std::vector<float>&, CovarianceFlavour);
 extern template FitCovariance<SE3f> covariance_of(const Geodesic<SE3f>&,
                                                   const std::vector<SE3f::Tangent>&,
-                                                  const Problem<float>&, CovarianceFlavour, bool);
+                                                  const Problem<float>&, CovarianceFlavour);
 
 // SE(2), float
 extern template FitCovariance<SE2f> covariance(const RegressionResult<SE2f>&,
@@ -70,7 +70,7 @@ extern template FitCovariance<SE2f> covariance(const RegressionResult<SE2f>&,
                                                const std::vector<float>&, CovarianceFlavour);
 extern template FitCovariance<SE2f> covariance_of(const Geodesic<SE2f>&,
                                                   const std::vector<SE2f::Tangent>&,
-                                                  const Problem<float>&, CovarianceFlavour, bool);
+                                                  const Problem<float>&, CovarianceFlavour);
 
 // Sim(3), float
 extern template FitCovariance<Sim3f> covariance(const RegressionResult<Sim3f>&,
@@ -78,6 +78,6 @@ extern template FitCovariance<Sim3f> covariance(const RegressionResult<Sim3f>&,
                                                 const std::vector<float>&, CovarianceFlavour);
 extern template FitCovariance<Sim3f> covariance_of(const Geodesic<Sim3f>&,
                                                    const std::vector<Sim3f::Tangent>&,
-                                                   const Problem<float>&, CovarianceFlavour, bool);
+                                                   const Problem<float>&, CovarianceFlavour);
 
 }  // namespace bireg

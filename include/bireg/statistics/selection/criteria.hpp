@@ -63,9 +63,9 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 
@@ -265,20 +265,16 @@ double determinant_floor(std::vector<typename G::Tangent> spread,
       spread.push_back(G::log(G::compose(G::inverse(observations[n / 2]), observations[i])));
   }
   const auto spread_covariance = residual_covariance(spread);
-  const double largest_spread =
-      Eigen::SelfAdjointEigenSolver<std::decay_t<decltype(spread_covariance)>>(
-          spread_covariance, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
+  const double largest_spread = symmetric_eigen(spread_covariance).values.maxCoeff();
   return std::max(kDeterminantFloor * largest_spread, std::numeric_limits<double>::min());
 }
 
 template <class Square>
 double floored_log_det(const Square& s, double floor) {
-  const Eigen::SelfAdjointEigenSolver<Square> eigen(s, Eigen::EigenvaluesOnly);
+  const auto values = symmetric_eigen(s).values;
   double log_det = 0;
   for (Eigen::Index j = 0; j < s.rows(); ++j)
-    log_det += std::log(std::max(eigen.eigenvalues()[j], floor));
+    log_det += std::log(std::max(values[j], floor));
   return log_det;
 }
 

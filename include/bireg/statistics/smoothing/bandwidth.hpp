@@ -13,9 +13,9 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
+#include "bireg/math/small_lu.hpp"
+#include "bireg/math/symmetric_eigen.hpp"
 #include "bireg/statistics/smoothing/local_geodesic.hpp"
 
 namespace bireg {
@@ -91,9 +91,7 @@ typename G::Scalar generalised_variance(
   using std::log;
   const Scalar infinity = std::numeric_limits<Scalar>::infinity();
   if (!s.allFinite()) return infinity;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<Scalar, G::dof, G::dof>> solver(
-      s, Eigen::EigenvaluesOnly);
-  const auto& eigenvalues = solver.eigenvalues();
+  const auto eigenvalues = symmetric_eigen(s).values;
   const Scalar largest = eigenvalues.maxCoeff();
   if (!(largest > 0)) return infinity;
   Scalar sum_logs = 0;
@@ -295,8 +293,8 @@ HoldOut velocity_target(const Observations& observations, const Covariates& cova
     t[i] = Scalar(covariates[order[i]]);
     f[i] = observations[order[i]];
   }
-  const Eigen::FullPivLU<Eigen::Matrix<Scalar, d, d>> whitening(noise);
-  const bool whitened = whitening.rank() == d;
+  const SmallLU<Eigen::Matrix<Scalar, d, d>> whitening(noise);
+  const bool whitened = whitening.invertible();
   const Scalar trace = noise.trace();
   Scalar bias = 0, extra = 0;
   std::size_t count = 0;

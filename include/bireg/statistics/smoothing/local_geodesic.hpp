@@ -659,10 +659,8 @@ class LocalGeodesicRegression {
       return false;
     }
     const RegressionOptions<Scalar>& fit_options = options_.fit;
-    return with_step_rule<G>(fit_options.solver, [&](auto tag) {
-      using Rule = typename decltype(tag)::type;
-      if (Rule::refuse(problem, fit_options.step_size)) return false;
-      const Rule rule = make_rule<Rule>(problem, *previous);
+    // Compiled once for every step rule, through its view.
+    const auto warm_fit = [&](const StepRuleView<G>& rule) {
       const PsiEvaluation psi = fit_options.psi();
       const IterationControl<Scalar> control{fit_options.tolerance, fit_options.max_iterations,
                                              false, Stopping::predicted};
@@ -689,6 +687,12 @@ class LocalGeodesicRegression {
       }
       if (options_.quadratic_velocity) add_quadratic_slope(local, window, estimate);
       return true;
+    };
+    return with_step_rule<G>(fit_options.solver, [&](auto tag) {
+      using Rule = typename decltype(tag)::type;
+      if (Rule::refuse(problem, fit_options.step_size)) return false;
+      const Rule rule = make_rule<Rule>(problem, *previous);
+      return warm_fit(StepRuleView<G>(rule));
     });
   }
 

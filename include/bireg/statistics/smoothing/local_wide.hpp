@@ -56,6 +56,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/math/small_lu.hpp"
 #include "bireg/statistics/smoothing/local_window.hpp"
 
 namespace bireg {
@@ -104,7 +105,7 @@ RightJacobianPair<typename G::AdMatrix> jacobian_pair(const typename G::Tangent&
     return right_jacobian_pair<G>(x);
   } else {
     const typename G::AdMatrix jacobian = right_jacobian<G>(x);
-    return {jacobian, jacobian.inverse()};
+    return {jacobian, SmallLU<typename G::AdMatrix>(jacobian).inverse()};
   }
 }
 
@@ -223,8 +224,8 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
     const Force force = wide_detail::force<G>(window, fit.start, fit.displacement, fit.t_first,
                                               fit.t_last, nullptr);
     if (!force.finite) return fit;
-    const Eigen::FullPivLU<typename Force::Matrix> lu(force.k);
-    if (lu.rank() < 2 * d) return fit;
+    const SmallLU<typename Force::Matrix> lu(force.k);
+    if (!lu.invertible()) return fit;
     const typename Force::Vector step = lu.solve(force.v);
     const Tangent d0 = step.template head<d>(), d1 = step.template tail<d>();
     // exp(X') = exp(-d0) exp(X) exp(d1): first order, then one correction.
@@ -256,15 +257,16 @@ WideFit<G> wide_fit(const LocalWindow<G>& window, typename G::Scalar tau,
   const Force sandwich =
       wide_detail::force<G>(window, fit.start, fit.displacement, fit.t_first, fit.t_last, &noise);
   const typename Force::Matrix k_transpose = sandwich.k.transpose();
-  const Eigen::FullPivLU<typename Force::Matrix> transposed(k_transpose);
-  if (transposed.rank() < 2 * d) return fit;
+  const SmallLU<typename Force::Matrix> transposed(k_transpose);
+  if (!transposed.invertible()) return fit;
   Eigen::Matrix<Scalar, d, 2 * d> to_velocity;
   to_velocity.template leftCols<d>() = -inverse_jacobian(-fit.displacement);
   to_velocity.template rightCols<d>() = inverse_jacobian(fit.displacement);
   // L K^{-1} M K^{-T} L^T = (K^{-T} L^T)^T M (K^{-T} L^T).
   const Eigen::Matrix<Scalar, 2 * d, d> spread =
       transposed.solve(Eigen::Matrix<Scalar, 2 * d, d>(to_velocity.transpose()));
-  const AdMatrix velocity = spread.transpose() * sandwich.psi_scatter * spread / (range * range);
+  const AdMatrix velocity =
+      spread.transpose().lazyProduct(sandwich.psi_scatter.lazyProduct(spread)) / (range * range);
   if (!velocity.allFinite()) return fit;
   fit.velocity_error = velocity.diagonal().cwiseMax(Scalar(0)).cwiseSqrt();
   fit.velocity_error_defined = true;

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 
 #include "bireg/geodesic.hpp"
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/math/small_lu.hpp"
 #include "bireg/statistics/smoothing/kernel.hpp"
 
 namespace bireg {
@@ -273,15 +273,15 @@ QuadraticSlope<G> quadratic_slope(const Curve& local, const LocalWindow<G>& wind
     squared_weights.noalias() += (w * w) * z * z.transpose();
     moments.noalias() += w * z * r.transpose();
   }
-  const Eigen::FullPivLU<Matrix3> quadratic(normal);
-  if (quadratic.rank() < 3) return result;
+  const SmallLU<Matrix3> quadratic(normal);
+  if (!quadratic.invertible()) return result;
   const Vector3 slope_row = quadratic.solve(Vector3::UnitY());  // M^{-1} e_1 (M symmetric)
   const Tangent slope = (moments.transpose() * slope_row) / scale;
   if (!slope.allFinite()) return result;
   result.defined = true;
   result.slope = slope;
-  const Eigen::FullPivLU<Matrix2> linear(normal.template topLeftCorner<2, 2>());
-  if (linear.rank() < 2) return result;
+  const SmallLU<Matrix2> linear(normal.template topLeftCorner<2, 2>());
+  if (!linear.invertible()) return result;
   const Eigen::Matrix<Scalar, 2, 1> line_row = linear.solve(Eigen::Matrix<Scalar, 2, 1>::UnitY());
   const Scalar quadratic_variance = slope_row.dot(squared_weights * slope_row);
   const Scalar line_variance =
@@ -381,8 +381,8 @@ typename G::Scalar slope_weight(const LocalWindow<G>& window, typename G::Scalar
   }
   if (!found) return Scalar(0);
   if (size == 2) normal(2, 2) = Scalar(1);  // the unused quadratic column
-  const Eigen::FullPivLU<Matrix3> lu(normal);
-  if (lu.rank() < 3) return Scalar(0);
+  const SmallLU<Matrix3> lu(normal);
+  if (!lu.invertible()) return Scalar(0);
   const Vector3 row = lu.solve(Vector3::UnitY());
   return weight * row.dot(design(covariate)) / scale;
 }
