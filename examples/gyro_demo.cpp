@@ -63,6 +63,7 @@ struct Smoothed {
   std::vector<Vector3> velocity;
   double bandwidth = 0;       // the velocity's
   double pose_bandwidth = 0;  // the pose's
+  int degree = 2;             // the velocity's local polynomial
   int failed = 0;
   double mean_iterations = 0;
 };
@@ -77,8 +78,10 @@ Smoothed smooth(const std::vector<SO3::Element>& r, const std::vector<double>& t
   Smoothed out;
   out.bandwidth = selection.velocity_bandwidth;
   out.pose_bandwidth = selection.bandwidth;
+  out.degree = selection.velocity_degree;
   if (!selection.ok()) return out;
   options.bandwidth = selection.velocity_bandwidth;
+  options.velocity_degree = selection.velocity_degree;
   const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(r, t);
   long iterations = 0;
   for (const auto& e : estimates) {
@@ -238,10 +241,11 @@ std::vector<Vector3> print_row(const std::string& label, double noise,
                  label.c_str(), noise, smoothed.failed);
     return {};
   }
-  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f | %.2f | %s |\n", label.c_str(),
-              noise, rms_error(differences, truth), chart, chart_bandwidth,
+  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f, %s | %.2f | %s |\n",
+              label.c_str(), noise, rms_error(differences, truth), chart, chart_bandwidth,
               rms_error(smoothed.velocity, truth), smoothed.pose_bandwidth, smoothed.bandwidth,
-              smoothed.mean_iterations, spline_cell(r, t, truth, spline).c_str());
+              smoothed.degree == 3 ? "cubic" : "quadratic", smoothed.mean_iterations,
+              spline_cell(r, t, truth, spline).c_str());
   return smoothed.velocity;
 }
 
@@ -272,7 +276,8 @@ int main(int argc, char** argv) {
               rms_error(reference, std::vector<Vector3>(raw.size(), Vector3::Zero())));
   const char* header =
       "| recording | orientation noise (rad) | finite differences RMS (rad/s) | chart line "
-      "RMS, best bandwidth (s) | bireg RMS (rad/s) | bireg bandwidths, pose and velocity (s) "
+      "RMS, best bandwidth (s) | bireg RMS (rad/s) | bireg bandwidths, pose and velocity (s), "
+      "velocity's degree "
       "| GN iterations per query | cubic spline RMS, knot spacing (s) |\n"
       "|---|---|---|---|---|---|---|---|\n";
   std::printf("%s", header);

@@ -47,46 +47,89 @@ std::vector<double> irregular_covariates(std::mt19937& rng, int n) {
 
 }  // namespace
 
-// The pose is the local line's value; the velocity is the local line's
-// slope with quadratic_velocity off and the local quadratic's slope with it
-// on (the default), exactly, as DESIGN.md section 5 derives.
-TEST_CASE("On R^2 the local fit is local-linear, its velocity local-quadratic, least squares") {
+// The pose is the local line's value; the velocity is the slope of the
+// local polynomial of degree velocity_degree (1, the line; 2, the default
+// quadratic; 3, the cubic), exactly, as DESIGN.md section 5 derives.
+TEST_CASE("On R^2 the local fit is local-linear, its velocity local-polynomial, least squares") {
   std::mt19937 rng(14);
   const std::vector<double> t = irregular_covariates(rng, 60);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<R2::Element> f;
   for (const double ti : t)
     f.push_back(R2::Element(std::sin(6 * ti) + 0.1 * normal(rng), ti * ti));
+  constexpr double kBandwidth = 0.15;
   for (const bireg::Kernel kernel : kKernels) {
-    for (const bool quadratic : {false, true}) {
-      bireg::LocalRegressionOptions<double> options = local_options<R2>(kernel, 0.15);
-      options.quadratic_velocity = quadratic;
+    for (const int degree : {1, 2, 3}) {
+      bireg::LocalRegressionOptions<double> options = local_options<R2>(kernel, kBandwidth);
+      options.velocity_degree = degree;
       const auto estimates = bireg::LocalGeodesicRegression<R2>(options).smooth(f, t);
       for (std::size_t q = 0; q < t.size(); ++q) {
-        // min sum w_i |f_i - a - b u_i (- c u_i^2)|^2, u_i = t_i - tau:
-        // the normal equations of the line and of the parabola.
+        // min sum w_i |f_i - sum_k c_k v_i^k|^2, v_i = (t_i - tau) / h,
+        // k = 0..degree: the normal equations of the line and of the
+        // polynomial, in v for conditioning (the slope is c_1 / h).
         const double tau = t[q];
-        Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
-        Eigen::Matrix<double, 3, 2> right = Eigen::Matrix<double, 3, 2>::Zero();
+        const int size = degree + 1;
+        Eigen::MatrixXd normal_matrix = Eigen::MatrixXd::Zero(size, size);
+        Eigen::MatrixXd right = Eigen::MatrixXd::Zero(size, 2);
         for (std::size_t i = 0; i < t.size(); ++i) {
-          const double w = bireg::kernel_weight(kernel, (t[i] - tau) / 0.15);
-          const double u = t[i] - tau;
-          const Eigen::Vector3d design(1.0, u, u * u);
+          const double w = bireg::kernel_weight(kernel, (t[i] - tau) / kBandwidth);
+          const double v = (t[i] - tau) / kBandwidth;
+          Eigen::VectorXd design(size);
+          for (int k = 0; k < size; ++k)
+            design[k] = std::pow(v, k);
           normal_matrix += w * design * design.transpose();
           right += w * design * f[i].transpose();
         }
-        const Eigen::Matrix2d line =
-            normal_matrix.topLeftCorner<2, 2>().lu().solve(right.topRows<2>());
-        const Eigen::Matrix<double, 3, 2> parabola = normal_matrix.lu().solve(right);
-        const Eigen::Vector2d slope = quadratic ? Eigen::Vector2d(parabola.row(1).transpose())
-                                                : Eigen::Vector2d(line.row(1).transpose());
-        INFO("kernel " << bireg::to_string(kernel) << " quadratic " << quadratic << " query " << q);
+        const Eigen::Matrix2d line = normal_matrix.topLeftCorner(2, 2).lu().solve(right.topRows(2));
+        const Eigen::MatrixXd polynomial = normal_matrix.lu().solve(right);
+        const Eigen::Vector2d slope = polynomial.row(1).transpose() / kBandwidth;
+        INFO("kernel " << bireg::to_string(kernel) << " degree " << degree << " query " << q);
         REQUIRE(estimates[q].ok());
         // Values O(1), N = 60 sums: the solutions differ by rounding,
-        // ~1e-14 for the line; the parabola's normal matrix has moments
-        // up to h^4 ~ 5e-4 and a condition ~1e6, hence 1e-9 for its slope.
+        // ~1e-14 for the line; bireg scales u by the window's half-width
+        // (up to 4h), so its normal matrix has moments down to 4^-6 ~ 2e-4
+        // and a condition up to ~1e6, hence 1e-9 for the polynomials' slope.
         CHECK((estimates[q].pose - line.row(0).transpose()).norm() < 1e-12);
-        CHECK((estimates[q].velocity - slope).norm() < (quadratic ? 1e-9 : 1e-11));
+        CHECK((estimates[q].velocity - slope).norm() < (degree > 1 ? 1e-9 : 1e-11));
+      }
+    }
+  }
+}
+
+// The cubic removes the interior bias that the quadratic leaves: on a
+// rotation about a fixed axis whose angle is a cubic in t, noise-free, the
+// residuals of the local line are exactly cubic, so the local cubic's
+// slope is the rate (to rounding), where the quadratic's is off by the
+// angle's third derivative times h^2 / 2 in the interior (the Gaussian's
+// E s^4 / E s^2 = 3 h^2, divided by 3!).
+TEST_CASE("A cubic angle's rate: exact with the local cubic, biased with the quadratic") {
+  const double a = 0.4, b = -0.6, c = 1.5;  // theta(t) = a t + b t^2 + c t^3
+  const SO3::Tangent axis = SO3::Tangent(1, 2, 2) / 3;
+  std::vector<double> t;
+  std::vector<SO3::Element> f;
+  for (int i = 0; i <= 100; ++i) {
+    t.push_back(i / 100.0);
+    const double theta = a * t.back() + b * t.back() * t.back() + c * std::pow(t.back(), 3);
+    f.push_back(SO3::exp(theta * axis));
+  }
+  constexpr double kBandwidth = 0.05;
+  const double interior_bias = 6 * c * kBandwidth * kBandwidth / 2;  // 0.011 rad/s
+  for (const int degree : {2, 3}) {
+    bireg::LocalRegressionOptions<double> options =
+        local_options<SO3>(bireg::Kernel::gaussian, kBandwidth);
+    options.velocity_degree = degree;
+    const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
+    for (std::size_t q = 0; q < t.size(); ++q) {
+      REQUIRE(estimates[q].ok());
+      const double rate = a + 2 * b * t[q] + 3 * c * t[q] * t[q];
+      const double off = (estimates[q].velocity - rate * axis).norm();
+      INFO("degree " << degree << " query " << q << ": off by " << off);
+      if (degree == 3) {
+        // Rounding: the residuals are ~1e-4 rad, their slope's rounding
+        // ~1e-16 / h times the design's condition ~1e6.
+        CHECK(off < 1e-8);
+      } else if (q >= 20 && q <= 80) {  // the interior: 4 bandwidths in
+        CHECK(std::abs(off - interior_bias) < 0.1 * interior_bias);
       }
     }
   }
@@ -142,7 +185,7 @@ TEST_CASE("A bandwidth far past the range gives the global fit") {
   // up to the convergence tolerance (1e-10 on the step, quadratically: ~0).
   for (const bireg::Kernel kernel : kKernels) {
     bireg::LocalRegressionOptions<double> options = local_options<SO3>(kernel, 1e8);
-    options.quadratic_velocity = false;  // the geodesic's own velocity
+    options.velocity_degree = 1;  // the geodesic's own velocity
     const bireg::LocalGeodesicRegression<SO3> smoother(options);
     const std::vector<double> middle{0.5};
     const auto estimates = smoother.smooth_at(f, t, middle);
@@ -229,7 +272,7 @@ TEST_CASE("Warm queries take two evaluations and reach the certified fit's endpo
   const std::vector<SO3::Element>& f = data.f;
   const std::vector<double>& t = data.t;
   auto options = local_options<SO3>(bireg::Kernel::gaussian, kBandwidth);
-  options.quadratic_velocity = false;  // the geodesic's own velocity and errors
+  options.velocity_degree = 1;  // the geodesic's own velocity and errors
   const auto estimates = bireg::LocalGeodesicRegression<SO3>(options).smooth(f, t);
   int more_than_two = 0;
   for (std::size_t q = 0; q < estimates.size(); ++q) {

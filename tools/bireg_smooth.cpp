@@ -21,8 +21,10 @@
 // leave-one-out prediction, the velocity's against held-out chords, and
 // prints both as one line on stderr, and a warning line when a choice is at
 // the grid's edge or most values were refused; --cv-table FILE writes the
-// curves (CSV: bandwidth, criterion, failures, refused, and the same for
-// the velocity). It costs 40 smoothing passes, each window capped in turn
+// curves (CSV: bandwidth, criterion, failures, refused, the same for the
+// velocity, and the local cubic velocity's criterion: the velocity's
+// degree, quadratic or cubic, is chosen with its bandwidth and printed).
+// It costs up to 60 smoothing passes, each window capped in turn
 // and in the kernel's support; --progress (or a terminal on stderr) shows
 // how far it is after two seconds.
 //
@@ -368,15 +370,15 @@ std::optional<std::string> write_velocity(const std::string& path,
 }
 
 // The cross-validation curves of --bandwidth auto, one row per bandwidth:
-// its criteria (empty where refused), failed held-out fits, and why a
-// value was refused.
+// its criteria (empty where refused), failed held-out fits, why a value
+// was refused, and the local cubic velocity's criterion (the same fits).
 template <class Scalar>
 std::optional<std::string> write_cv_table(const std::string& path,
                                           const bireg::BandwidthSelection<Scalar>& selection) {
   namespace io = bireg::io;
   std::string text =
       "bandwidth,criterion,failures,refused,velocity_criterion,velocity_failures,"
-      "velocity_refused\n";
+      "velocity_refused,cubic_velocity_criterion\n";
   const auto number = [&](Scalar x) {
     if (std::isfinite(x)) io::append_double(text, x);
   };
@@ -388,13 +390,17 @@ std::optional<std::string> write_cv_table(const std::string& path,
             bireg_cli::csv_field(selection.refusals[k]) + ',';
     number(selection.velocity_criterion[k]);
     text += ',' + std::to_string(selection.velocity_failures[k]) + ',' +
-            bireg_cli::csv_field(selection.velocity_refusals[k]) + '\n';
+            bireg_cli::csv_field(selection.velocity_refusals[k]) + ',';
+    if (k < selection.cubic_velocity_criterion.size()) {
+      number(selection.cubic_velocity_criterion[k]);
+    }
+    text += '\n';
   }
   return bireg_cli::write_text_file(path, text);
 }
 
 // The local method: poses at the pose bandwidth and, when --velocity asks
-// and the velocity's bandwidth differs, velocities at their own. Returns an
+// and the velocity's bandwidth or degree differs, velocities at their own. Returns an
 // exit code when it cannot go on.
 template <class G>
 std::optional<int> local_estimates(const Command& command, const std::string& name,
@@ -407,6 +413,7 @@ std::optional<int> local_estimates(const Command& command, const std::string& na
   options.kernel = command.kernel;
   options.threads = command.threads;
   double velocity_bandwidth = 0;
+  int velocity_degree = options.velocity_degree;
   if (command.bandwidth) {
     options.bandwidth = *command.bandwidth;
     velocity_bandwidth = options.bandwidth;
@@ -430,11 +437,13 @@ std::optional<int> local_estimates(const Command& command, const std::string& na
     }
     options.bandwidth = selection.bandwidth;
     velocity_bandwidth = selection.velocity_bandwidth;
+    velocity_degree = selection.velocity_degree;
     std::fprintf(stderr,
                  "bireg_smooth: bandwidth auto: %s s for the poses, %s s for the velocity "
-                 "(cross-validation over %zu values from %s to %s s)\n",
+                 "(local %s; cross-validation over %zu values from %s to %s s)\n",
                  io::json_number(selection.bandwidth).c_str(),
-                 io::json_number(selection.velocity_bandwidth).c_str(), grid.size(),
+                 io::json_number(selection.velocity_bandwidth).c_str(),
+                 velocity_degree == 3 ? "cubic" : "quadratic", grid.size(),
                  io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
     if (!selection.message.empty()) {
       std::fprintf(stderr, "bireg_smooth: warning: bandwidth auto: %s\n",
@@ -443,9 +452,11 @@ std::optional<int> local_estimates(const Command& command, const std::string& na
   }
   estimates = bireg::LocalGeodesicRegression<G>(options).smooth_at(trajectory.observations,
                                                                    trajectory.covariates, queries);
-  if (!command.velocity.empty() && velocity_bandwidth != options.bandwidth) {
+  if (!command.velocity.empty() &&
+      (velocity_bandwidth != options.bandwidth || velocity_degree != options.velocity_degree)) {
     bireg::LocalRegressionOptions<double> velocity_options = options;
     velocity_options.bandwidth = velocity_bandwidth;
+    velocity_options.velocity_degree = velocity_degree;
     velocity_estimates = bireg::LocalGeodesicRegression<G>(velocity_options)
                              .smooth_at(trajectory.observations, trajectory.covariates, queries);
   }

@@ -119,7 +119,7 @@ def score(fit: FitHandle, t: Annotated[NDArray[numpy.float64], dict(shape=(None,
 def trend_test(fit: FitHandle, permutations: int, seed: int, threads: int) -> dict:
     """bireg::trend_test with the fit's options: statistic and p_value."""
 
-def smooth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], queries: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], kernel: str, bandwidth: float, velocity_bandwidth: float, threads: int) -> dict:
+def smooth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], queries: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], kernel: str, bandwidth: float, velocity_bandwidth: float, velocity_degree: int, threads: int) -> dict:
     """
     LocalGeodesicRegression<G>::smooth_at: pose, velocity, standard errors, status per query.
     """

@@ -14,8 +14,10 @@ from . import groups as _groups
 class LocalRegression:
     """``bandwidth="auto"``: chosen by cross-validation over
     bireg::auto_bandwidth_grid, one bandwidth for the poses and one for the
-    velocity (bireg::select_bandwidth), as ``bireg_smooth --bandwidth auto``.
-    A float: that bandwidth, in covariate units, for both.
+    velocity (bireg::select_bandwidth), as ``bireg_smooth --bandwidth auto``;
+    the velocity's local polynomial degree (``velocity_degree_``: 2, the
+    local quadratic, or 3, the local cubic) is chosen with its bandwidth.
+    A float: that bandwidth, in covariate units, for both, and the quadratic.
     """
 
     def __init__(self, group="SE3", bandwidth="auto", kernel="gaussian", threads=1):
@@ -34,12 +36,14 @@ class LocalRegression:
             selection = _bireg.select_bandwidth(group.name, t, Y, self.kernel, threads)
             self.bandwidth_ = selection["bandwidth"]
             self.velocity_bandwidth_ = selection["velocity_bandwidth"]
+            self.velocity_degree_ = selection["velocity_degree"]
             self.bandwidth_selection_ = selection
             if selection["message"]:
                 warnings.warn(f"bandwidth auto: {selection['message']}", UserWarning,
                               stacklevel=2)
         else:
             self.bandwidth_ = self.velocity_bandwidth_ = float(self.bandwidth)
+            self.velocity_degree_ = 2
             self.bandwidth_selection_ = None
         self._t, self._Y, self._group = t, Y, group
         return self
@@ -49,6 +53,7 @@ class LocalRegression:
             raise ValueError("this LocalRegression is not fitted yet: call fit(t, Y) first")
         return _bireg.smooth(self._group.name, self._t, self._Y, _arrays.covariates(t_new),
                              self.kernel, self.bandwidth_, self.velocity_bandwidth_,
+                             self.velocity_degree_,
                              _arrays.positive_int(self.threads, "threads"))
 
     def predict(self, t_new):

@@ -63,17 +63,21 @@ void bind_statistics(nb::module_& m) {
   m.def(
       "smooth",
       [](const std::string& group, const Vector& t, const Stack& y, const Vector& queries,
-         const std::string& kernel, double bandwidth, double velocity_bandwidth, int threads) {
+         const std::string& kernel, double bandwidth, double velocity_bandwidth,
+         int velocity_degree, int threads) {
         const auto options = statistics_detail::local_options(kernel, bandwidth, threads);
         if (!(velocity_bandwidth > 0) || !std::isfinite(velocity_bandwidth))
           refuse("velocity bandwidth must be a finite positive number");
+        if (velocity_degree < 1 || velocity_degree > 3)
+          refuse("velocity_degree must be 1, 2 or 3, got " + std::to_string(velocity_degree));
         return with_group(group, [&](auto tag) {
-          return GroupStatistics<typename decltype(tag)::type>::smooth(t, y, queries, options,
-                                                                       velocity_bandwidth);
+          return GroupStatistics<typename decltype(tag)::type>::smooth(
+              t, y, queries, options, velocity_bandwidth, velocity_degree);
         });
       },
       nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("queries"), nb::arg("kernel"),
-      nb::arg("bandwidth"), nb::arg("velocity_bandwidth"), nb::arg("threads"),
+      nb::arg("bandwidth"), nb::arg("velocity_bandwidth"), nb::arg("velocity_degree"),
+      nb::arg("threads"),
       "LocalGeodesicRegression<G>::smooth_at: pose, velocity, standard errors, status per query.");
   m.def(
       "select_bandwidth",

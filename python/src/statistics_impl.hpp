@@ -170,7 +170,8 @@ nb::dict trend_test(const GroupFit<G>& fit, int permutations, std::uint64_t seed
 // covariate unit), the velocity's standard errors, status and message.
 template <class G>
 nb::dict smooth(const Vector& t, const Stack& y, const Vector& queries,
-                const bireg::LocalRegressionOptions<double>& options, double velocity_bandwidth) {
+                const bireg::LocalRegressionOptions<double>& options, double velocity_bandwidth,
+                int velocity_degree) {
   const StackView<G> poses(y);
   const std::vector<double> covariates = to_vector(t), at = to_vector(queries);
   {
@@ -182,9 +183,10 @@ nb::dict smooth(const Vector& t, const Stack& y, const Vector& queries,
   {
     nb::gil_scoped_release release;
     estimates = bireg::LocalGeodesicRegression<G>(options).smooth_at(poses, covariates, at);
-    if (velocity_bandwidth != options.bandwidth) {
+    if (velocity_bandwidth != options.bandwidth || velocity_degree != options.velocity_degree) {
       bireg::LocalRegressionOptions<double> velocity_options = options;
       velocity_options.bandwidth = velocity_bandwidth;
+      velocity_options.velocity_degree = velocity_degree;
       velocities =
           bireg::LocalGeodesicRegression<G>(velocity_options).smooth_at(poses, covariates, at);
     }
@@ -233,9 +235,11 @@ nb::dict select_bandwidth(const Vector& t, const Stack& y,
   nb::dict out;
   out["bandwidth"] = s.bandwidth;
   out["velocity_bandwidth"] = s.velocity_bandwidth;
+  out["velocity_degree"] = s.velocity_degree;
   out["grid"] = vector_array(s.grid);
   out["criterion"] = vector_array(s.criterion);
   out["velocity_criterion"] = vector_array(s.velocity_criterion);
+  out["cubic_velocity_criterion"] = vector_array(s.cubic_velocity_criterion);
   out["message"] = s.message;
   return out;
 }
@@ -268,7 +272,7 @@ struct GroupStatistics {
                              int threads);
   static nb::dict smooth(const Vector& t, const Stack& y, const Vector& queries,
                          const bireg::LocalRegressionOptions<double>& options,
-                         double velocity_bandwidth);
+                         double velocity_bandwidth, int velocity_degree);
   static nb::dict select_bandwidth(const Vector& t, const Stack& y,
                                    const bireg::LocalRegressionOptions<double>& options);
 };
@@ -306,8 +310,8 @@ nb::dict GroupStatistics<G>::trend_test(const FitHandle& fit, int permutations, 
 template <class G>
 nb::dict GroupStatistics<G>::smooth(const Vector& t, const Stack& y, const Vector& queries,
                                     const bireg::LocalRegressionOptions<double>& options,
-                                    double velocity_bandwidth) {
-  return statistics_detail::smooth<G>(t, y, queries, options, velocity_bandwidth);
+                                    double velocity_bandwidth, int velocity_degree) {
+  return statistics_detail::smooth<G>(t, y, queries, options, velocity_bandwidth, velocity_degree);
 }
 
 template <class G>

@@ -24,6 +24,16 @@ def test_velocity_of_a_constant_spin_with_auto_bandwidth():
     # velocity itself, against its reported standard errors.
     local = bireg.LocalRegression(group="SO3", bandwidth="auto").fit(t, Y)
     assert local.bandwidth_ > 0 and local.velocity_bandwidth_ > 0
+    # The velocity's degree is chosen with its bandwidth, from two curves
+    # over the same grid.
+    assert local.velocity_degree_ in (2, 3)
+    selection = local.bandwidth_selection_
+    assert len(selection["cubic_velocity_criterion"]) == len(selection["grid"])
+    best = np.nanmin(np.where(np.isfinite(selection["velocity_criterion"]),
+                              selection["velocity_criterion"], np.inf))
+    best_cubic = np.nanmin(np.where(np.isfinite(selection["cubic_velocity_criterion"]),
+                                    selection["cubic_velocity_criterion"], np.inf))
+    assert local.velocity_degree_ == (3 if best_cubic < best else 2)
     out = local.velocity(t[20:-20])
     assert out["ok"].all()
     v = out["velocity"]

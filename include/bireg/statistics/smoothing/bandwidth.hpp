@@ -27,7 +27,11 @@ struct BandwidthSelection {
   // The admissible grid value with the smallest criterion (0: none).
   Scalar bandwidth = 0;           // for the pose
   Scalar velocity_bandwidth = 0;  // for the velocity
-  std::vector<Scalar> grid;       // ascending
+  // The velocity's local polynomial degree chosen with velocity_bandwidth
+  // (LocalRegressionOptions::velocity_degree): the options' own, or 3 where
+  // the options' is 2 and the cubic's curve has the smaller minimum.
+  int velocity_degree = 2;
+  std::vector<Scalar> grid;  // ascending
   // Per grid value: the generalised variance det(S_h)^(1/d) of the
   // cross-validation errors, S_h = (1/M) sum e_i e_i^T over the M
   // observations compared (below). Left invariant; right translation
@@ -39,6 +43,10 @@ struct BandwidthSelection {
   // two share (LocalGeodesicRegression::held_out, HoldOut::chords).
   std::vector<Scalar> criterion;
   std::vector<Scalar> velocity_criterion;
+  // The same for the local cubic's velocity (velocity_degree 3), compared
+  // with velocity_criterion on the same observations; empty when it was
+  // not evaluated (the options' degree is not 2, or the fits are robust).
+  std::vector<Scalar> cubic_velocity_criterion;
   // What the velocity's errors are measured against: the chords between
   // neighbours, or the five-point derivatives where the chords' bias would
   // cost more than the derivatives' noise (velocity_target).
@@ -56,6 +64,7 @@ struct BandwidthSelection {
   std::vector<std::string> first_failures;
   std::vector<std::string> refusals;  // why a grid value was refused, else empty
   std::vector<std::string> velocity_refusals;
+  std::vector<std::string> cubic_velocity_refusals;
   std::size_t compared = 0;
   std::size_t velocity_compared = 0;
   // Whether a choice is the grid's first or last value (the best value
@@ -331,9 +340,16 @@ HoldOut velocity_target(const Observations& observations, const Covariates& cova
 // each curve. The bandwidth that predicts the pose best is narrower than
 // the one that estimates its derivative best (a derivative's optimal
 // bandwidth shrinks more slowly with the noise), hence two choices.
-// `progress`, when set, is called with (done, total) after each held-out
-// pass (2 per grid value). Cost: two local fits per observation per grid
-// value evaluated, each over its window; windows are capped in turn
+// Where options.velocity_degree is 2 (the default) and the fits are not
+// robust, the velocity's curve is also evaluated for the local cubic
+// (degree 3), and the velocity's choice is the (degree, bandwidth) with
+// the smallest criterion of the two curves (velocity_degree says which):
+// the criterion estimates the velocity's mean squared error up to a
+// constant that depends on neither. Set velocity_degree to 1 or 3 to fix
+// the degree. `progress`, when set, is called with (done, total) after
+// the pose's and after the velocity's held-out passes (2 per grid value).
+// Cost: two local fits per observation per grid value evaluated (three
+// with the cubic's curve), each over its window; windows are capped in turn
 // (Options::max_turn) and in the kernel's support, and the values past
 // both curves' minima are skipped (below), so the widest values, O(N^2)
 // each on slow motion over a long range, are seldom reached.
@@ -386,7 +402,11 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
   Scalar best_pose = std::numeric_limits<Scalar>::infinity();
   Scalar best_velocity = best_pose;
   std::size_t rises = 0;
-  std::vector<HeldOut<G>> poses, velocities;
+  // The cubic's velocity is a second curve over the same grid (DESIGN.md
+  // section 5, "The velocity's degree"): the same local fits, another
+  // polynomial through their residuals.
+  const bool try_cubic = options.velocity_degree == 2 && !options.robust;
+  std::vector<HeldOut<G>> poses, velocities, cubics;
   for (std::size_t j = 0; j < k; ++j) {
     if (rises >= kRisesBeforeStop) {
       HeldOut<G> skipped;
@@ -394,6 +414,7 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
                         std::to_string(kRisesBeforeStop) + " smaller bandwidths";
       poses.push_back(skipped);
       velocities.push_back(skipped);
+      if (try_cubic) cubics.push_back(skipped);
     } else {
       options.bandwidth = selection.grid[j];
       const LocalGeodesicRegression<G> smoother(options);
@@ -406,9 +427,16 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
         noise_ready = true;
       }
       velocities.push_back(smoother.held_out(observations, covariates, selection.velocity_target));
+      Scalar velocity = provisional(velocities.back(), &noise);
+      if (try_cubic) {
+        LocalRegressionOptions<Scalar> cubic_options = options;
+        cubic_options.velocity_degree = 3;
+        cubics.push_back(LocalGeodesicRegression<G>(cubic_options)
+                             .held_out(observations, covariates, selection.velocity_target));
+        velocity = std::min(velocity, provisional(cubics.back(), &noise));
+      }
       if (progress) progress(2 * j + 2, 2 * k);
       const Scalar pose = provisional(poses.back(), nullptr);
-      const Scalar velocity = provisional(velocities.back(), &noise);
       const bool improved = pose < best_pose || velocity < best_velocity;
       best_pose = std::min(best_pose, pose);
       best_velocity = std::min(best_velocity, velocity);
@@ -425,9 +453,28 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
   const std::size_t pose_best =
       local_regression_detail::choose<G>(poses, n, selection.refusals, selection.criterion,
                                          selection.compared, &selection.mean_squared_error);
-  const std::size_t velocity_best = local_regression_detail::choose<G>(
+  // Both degrees' curves in one choice, so that they are compared on the
+  // same observations; then split back into the two curves.
+  const std::size_t curves = velocities.size();
+  velocities.insert(velocities.end(), cubics.begin(), cubics.end());
+  std::size_t velocity_best = local_regression_detail::choose<G>(
       velocities, n, selection.velocity_refusals, selection.velocity_criterion,
       selection.velocity_compared, nullptr, &noise);
+  selection.velocity_degree = options.velocity_degree;
+  if (try_cubic) {
+    selection.cubic_velocity_criterion.assign(selection.velocity_criterion.begin() + curves,
+                                              selection.velocity_criterion.end());
+    selection.cubic_velocity_refusals.assign(selection.velocity_refusals.begin() + curves,
+                                             selection.velocity_refusals.end());
+    selection.velocity_criterion.resize(curves);
+    selection.velocity_refusals.resize(curves);
+    if (velocity_best == 2 * k) {
+      velocity_best = k;  // none admissible
+    } else if (velocity_best >= k) {
+      velocity_best -= k;
+      selection.velocity_degree = 3;
+    }
+  }
   selection.problems = selection.refusals;
   for (std::size_t j = 0; j < k; ++j) {
     if (selection.problems[j].empty()) selection.problems[j] = selection.first_failures[j];

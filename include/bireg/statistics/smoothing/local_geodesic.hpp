@@ -102,20 +102,24 @@ struct LocalRegressionOptions {
   // motion is fast, the window is as wide as the turn allows. The turn is
   // invariant under conjugation, so the cut is left and right invariant.
   Scalar max_turn = Scalar(2.5);
-  // The velocity from a local quadratic rather than the local geodesic:
-  // the weighted least-squares fit of the geodesic's residuals
-  // r_i = log(gamma(t_i)^{-1} f_i) on (1, t_i - tau, (t_i - tau)^2) adds
-  // its slope to the geodesic's velocity. On R^n this is local quadratic
-  // regression's derivative exactly; in the interior of evenly sampled
-  // data it changes nothing (the quadratic column is orthogonal to the
-  // linear one), at the ends of the data it removes the local line's
-  // first-order bias in the derivative (DESIGN.md section 5, "Velocity at
-  // the ends"). The residuals map by Ad under right translation and are
-  // left invariant, so the velocity keeps both equivariances. Its standard
-  // errors are the geodesic's times the ratio of the two designs' slope
-  // variances. Robust queries (`robust` below) report the robust
-  // geodesic's velocity: this does not apply to them.
-  bool quadratic_velocity = true;
+  // The degree p of the local polynomial whose slope is the velocity: 1,
+  // the local geodesic's own velocity; p = 2 or 3, the weighted
+  // least-squares fit of the geodesic's residuals
+  // r_i = log(gamma(t_i)^{-1} f_i) on (1, t_i - tau, ..., (t_i - tau)^p)
+  // adds its slope to the geodesic's velocity. On R^n this is local
+  // polynomial regression's derivative exactly. The quadratic (the default)
+  // changes nothing in the interior of evenly sampled data (the quadratic
+  // column is orthogonal to the linear one) and at the ends of the data
+  // removes the local line's first-order bias in the derivative
+  // (DESIGN.md section 5, "Velocity at the ends"); the cubic also removes
+  // the interior's bias from the rate's curvature, for more variance at
+  // the same bandwidth (DESIGN.md section 5, "The velocity's degree"):
+  // select_bandwidth chooses between the two. The residuals map by Ad under
+  // right translation and are left invariant, so the velocity keeps both
+  // equivariances. Its standard errors are the geodesic's times the ratio
+  // of the two designs' slope variances. Robust queries (`robust` below)
+  // report the robust geodesic's velocity: this does not apply to them.
+  int velocity_degree = 2;
   // Where the turn cut shortened a window (fast rotation), refit the
   // window that may turn by max_turn on each side of the query (its path,
   // local_window.hpp's path_radius) instead of max_turn in all, carried by
@@ -321,7 +325,7 @@ class LocalGeodesicRegression {
     held.ok.assign(n, 0);
     if (mode != HoldOut::one) held.cross.assign(n, Scalar(0));
     // Robust queries report the robust geodesic's velocity.
-    const bool quadratic = options_.quadratic_velocity && !options_.robust;
+    const int degree = options_.robust ? 1 : options_.velocity_degree;
     // Per block, its first failure: the first block's that is set is the
     // serial loop's.
     std::vector<std::string> block_failures(block_count(n));
@@ -374,7 +378,7 @@ class LocalGeodesicRegression {
           held.errors[order[i]] = estimate.velocity - target;
           Scalar cross = 0;
           const auto slope_weight_of = [&](Scalar covariate) {
-            return slope_weight<G>(used, tau, covariate, quadratic);
+            return slope_weight<G>(used, tau, covariate, degree);
           };
           if (five.defined) {
             for (std::size_t k = 0; k < 5; ++k)
@@ -407,6 +411,9 @@ class LocalGeodesicRegression {
     }
     if (!(options_.max_turn > 0) || !(options_.max_turn <= Scalar(2.5))) {
       return "max_turn must be in (0, 2.5] radians";
+    }
+    if (options_.velocity_degree < 1 || options_.velocity_degree > 3) {
+      return "velocity_degree must be 1, 2 or 3, got " + std::to_string(options_.velocity_degree);
     }
     if (options_.fit.interval) return "the local fits set their own interval: leave it empty";
     if (options_.threads < 1)
@@ -539,7 +546,7 @@ class LocalGeodesicRegression {
     estimate.velocity_error_defined = fit.velocity_error_defined;
     estimate.window = wide.covariates.size();
     estimate.widened = true;
-    if (options_.quadratic_velocity) add_quadratic_slope(fit, wide, estimate);
+    add_polynomial_slope(fit, wide, estimate);
   }
 
   // The estimate on the narrow window, with the fallback below.
@@ -641,7 +648,7 @@ class LocalGeodesicRegression {
     if (options_.standard_errors) {
       set_velocity_error(covariance(fit, window.covariates, window.weights), estimate);
     }
-    if (options_.quadratic_velocity) add_quadratic_slope(local, window, estimate);
+    add_polynomial_slope(local, window, estimate);
   }
 
   // The local fit from the previous query's geodesic at the window's ends,
@@ -685,7 +692,7 @@ class LocalGeodesicRegression {
         }
         set_velocity_error(covariance_of(local, buffers.residuals, problem), estimate);
       }
-      if (options_.quadratic_velocity) add_quadratic_slope(local, window, estimate);
+      add_polynomial_slope(local, window, estimate);
       return true;
     };
     return with_step_rule<G>(fit_options.solver, [&](auto tag) {
@@ -716,15 +723,17 @@ class LocalGeodesicRegression {
     }
   }
 
-  // Options::quadratic_velocity: the slope of the quadratic fit of the
-  // local geodesic's residuals (local_window.hpp, quadratic_slope) added to
-  // its velocity, the standard errors scaled to the quadratic design's.
+  // Options::velocity_degree p >= 2: the slope of the degree-p fit of the
+  // local geodesic's residuals (local_window.hpp, polynomial_slope) added
+  // to its velocity, the standard errors scaled to that design's.
   template <class Curve>
-  static void add_quadratic_slope(const Curve& local, const Window& window, Estimate& estimate) {
-    const QuadraticSlope<G> quadratic = quadratic_slope<G>(local, window, estimate.covariate);
-    if (!quadratic.defined) return;
-    estimate.velocity += quadratic.slope;
-    if (estimate.velocity_error_defined) estimate.velocity_error *= quadratic.error_ratio;
+  void add_polynomial_slope(const Curve& local, const Window& window, Estimate& estimate) const {
+    if (options_.velocity_degree < 2) return;
+    const PolynomialSlope<G> polynomial =
+        polynomial_slope<G>(local, window, estimate.covariate, options_.velocity_degree);
+    if (!polynomial.defined) return;
+    estimate.velocity += polynomial.slope;
+    if (estimate.velocity_error_defined) estimate.velocity_error *= polynomial.error_ratio;
   }
 
   static void set_velocity_error(const FitCovariance<G>& c, Estimate& estimate) {

@@ -1,11 +1,12 @@
 // bireg: the window of a local regression query (statistics/smoothing/local_geodesic.hpp):
 // which observations it holds, how far it may reach on fast rotation, and
-// the quadratic correction of its velocity (DESIGN.md section 5).
+// the polynomial correction of its velocity (DESIGN.md section 5).
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -226,67 +227,119 @@ bool fill_window(const std::vector<typename G::Element>& f,
   return cut;
 }
 
-// The slope of a quadratic fit of a local curve's residuals (below).
+// The slope of a polynomial fit of a local curve's residuals (below).
 template <class G>
-struct QuadraticSlope {
+struct PolynomialSlope {
   bool defined = false;
+  int degree = 0;                                  // the degree fitted
   typename G::Tangent slope = G::Tangent::Zero();  // per covariate unit
-  typename G::Scalar error_ratio = 1;              // quadratic over linear slope standard error
+  typename G::Scalar error_ratio = 1;              // polynomial over linear slope standard error
 };
 
-// LocalRegressionOptions::quadratic_velocity: with u_i = (t_i - tau) / s (s the
-// window's half-width, for conditioning), z_i = (1, u_i, u_i^2) and the
-// normal matrix M = sum w_i z_i z_i^T, the quadratic fit of the residuals
-// has slope beta = (e_1^T M^{-1} sum w_i z_i r_i^T) / s, which the local
-// regression adds to the geodesic's velocity. Its variance for residuals of equal variance is
-// sigma^2 e_1^T M^{-1} (sum w_i^2 z_i z_i^T) M^{-1} e_1 / s^2, the
-// geodesic's (a local line's) the same with z_i = (1, u_i): error_ratio is
-// the square root of their ratio, by which the standard errors are scaled.
-// Not defined when the window has fewer than three distinct covariates or
-// M is singular to working precision. `local(t)` is the local geodesic's
-// pose at t (a Geodesic<G>, or the wide fit's curve).
+namespace local_regression_detail {
+
+// The normal matrix M = sum w_i z_i z_i^T of the weighted least-squares
+// fit on z_i = (1, u_i, ..., u_i^degree), u_i = (t_i - tau) / scale, in the
+// top-left (degree + 1) block of a 4 x 4 whose unused diagonal is 1 (so
+// one LU serves every degree up to 3); also sum w_i^2 z_i z_i^T.
+template <class G>
+struct PolynomialDesign {
+  using Scalar = typename G::Scalar;
+  using Matrix4 = Eigen::Matrix<Scalar, 4, 4>;
+  using Vector4 = Eigen::Matrix<Scalar, 4, 1>;
+  int degree;
+  Scalar tau;
+  Scalar scale;
+  Matrix4 normal = Matrix4::Zero();
+  Matrix4 squared_weights = Matrix4::Zero();
+
+  PolynomialDesign(const LocalWindow<G>& window, Scalar tau_, int degree_)
+      : degree(degree_), tau(tau_) {
+    using std::abs;
+    scale = std::max(abs(window.covariates.front() - tau), abs(window.covariates.back() - tau));
+    for (std::size_t i = 0; i < window.covariates.size(); ++i) {
+      const Vector4 z = row(window.covariates[i]);
+      const Scalar w = window.weights[i];
+      normal.noalias() += w * z * z.transpose();
+      squared_weights.noalias() += (w * w) * z * z.transpose();
+    }
+    for (int k = degree + 1; k < 4; ++k)
+      normal(k, k) = Scalar(1);
+  }
+
+  Vector4 row(Scalar t) const {
+    const Scalar u = (t - tau) / scale;
+    Vector4 z = Vector4::Zero();
+    Scalar power = 1;
+    for (int k = 0; k <= degree; ++k, power *= u)
+      z[k] = power;
+    return z;
+  }
+};
+
+// The largest degree in [1, requested] whose design the window supports
+// (more distinct covariates than the degree, M invertible), with M's LU;
+// degree 0 when not even the line's is.
+template <class G>
+int supported_degree(const LocalWindow<G>& window, typename G::Scalar tau, int requested,
+                     std::optional<PolynomialDesign<G>>& design,
+                     std::optional<SmallLU<Eigen::Matrix<typename G::Scalar, 4, 4>>>& lu) {
+  const int largest = static_cast<int>(std::min<std::size_t>(window.covariates.size(), 4)) - 1;
+  for (int degree = std::min(requested, largest); degree >= 1; --degree) {
+    design.emplace(window, tau, degree);
+    lu.emplace(design->normal);
+    if (lu->invertible()) return degree;
+  }
+  return 0;
+}
+
+}  // namespace local_regression_detail
+
+// LocalRegressionOptions::velocity_degree p >= 2: with u_i = (t_i - tau) / s
+// (s the window's half-width, for conditioning), z_i = (1, u_i, ..., u_i^p)
+// and the normal matrix M = sum w_i z_i z_i^T, the degree-p fit of the
+// residuals r_i = log(local(t_i)^{-1} f_i) has slope
+// beta = (e_1^T M^{-1} sum w_i z_i r_i^T) / s, which the local regression
+// adds to the geodesic's velocity. Its variance for residuals of equal
+// variance is sigma^2 e_1^T M^{-1} (sum w_i^2 z_i z_i^T) M^{-1} e_1 / s^2,
+// the geodesic's (a local line's) the same with z_i = (1, u_i): error_ratio
+// is the square root of their ratio, by which the standard errors are
+// scaled. A window with too few distinct covariates for degree p gets the
+// largest degree it supports (`degree`); not defined below degree 2 or
+// where the slope is not finite. `local(t)` is the local geodesic's pose
+// at t (a Geodesic<G>, or the wide fit's curve).
 template <class G, class Curve>
-QuadraticSlope<G> quadratic_slope(const Curve& local, const LocalWindow<G>& window,
-                                  typename G::Scalar tau) {
+PolynomialSlope<G> polynomial_slope(const Curve& local, const LocalWindow<G>& window,
+                                    typename G::Scalar tau, int degree) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
   using Matrix2 = Eigen::Matrix<Scalar, 2, 2>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using std::abs;
+  using Vector4 = Eigen::Matrix<Scalar, 4, 1>;
   using std::sqrt;
-  QuadraticSlope<G> result;
-  const std::size_t m = window.covariates.size();
-  if (m < 3) return result;
-  const Scalar scale =
-      std::max(abs(window.covariates.front() - tau), abs(window.covariates.back() - tau));
-  Matrix3 normal = Matrix3::Zero();
-  Matrix3 squared_weights = Matrix3::Zero();
-  Eigen::Matrix<Scalar, 3, G::dof> moments = Eigen::Matrix<Scalar, 3, G::dof>::Zero();
-  for (std::size_t i = 0; i < m; ++i) {
-    const Scalar u = (window.covariates[i] - tau) / scale;
-    const Vector3 z(Scalar(1), u, u * u);
-    const Scalar w = window.weights[i];
+  PolynomialSlope<G> result;
+  if (window.covariates.size() < 3) return result;
+  std::optional<local_regression_detail::PolynomialDesign<G>> design;
+  std::optional<SmallLU<Eigen::Matrix<Scalar, 4, 4>>> lu;
+  result.degree = local_regression_detail::supported_degree<G>(window, tau, degree, design, lu);
+  if (result.degree < 2) return result;
+  Eigen::Matrix<Scalar, 4, G::dof> moments = Eigen::Matrix<Scalar, 4, G::dof>::Zero();
+  for (std::size_t i = 0; i < window.covariates.size(); ++i) {
     const Tangent r =
         G::log(G::compose(G::inverse(local(window.covariates[i])), window.observations[i]));
-    normal.noalias() += w * z * z.transpose();
-    squared_weights.noalias() += (w * w) * z * z.transpose();
-    moments.noalias() += w * z * r.transpose();
+    moments.noalias() += window.weights[i] * design->row(window.covariates[i]) * r.transpose();
   }
-  const SmallLU<Matrix3> quadratic(normal);
-  if (!quadratic.invertible()) return result;
-  const Vector3 slope_row = quadratic.solve(Vector3::UnitY());  // M^{-1} e_1 (M symmetric)
-  const Tangent slope = (moments.transpose() * slope_row) / scale;
+  const Vector4 slope_row = lu->solve(Vector4::UnitY());  // M^{-1} e_1 (M symmetric)
+  const Tangent slope = (moments.transpose() * slope_row) / design->scale;
   if (!slope.allFinite()) return result;
   result.defined = true;
   result.slope = slope;
-  const SmallLU<Matrix2> linear(normal.template topLeftCorner<2, 2>());
+  const SmallLU<Matrix2> linear(design->normal.template topLeftCorner<2, 2>());
   if (!linear.invertible()) return result;
   const Eigen::Matrix<Scalar, 2, 1> line_row = linear.solve(Eigen::Matrix<Scalar, 2, 1>::UnitY());
-  const Scalar quadratic_variance = slope_row.dot(squared_weights * slope_row);
+  const Scalar polynomial_variance = slope_row.dot(design->squared_weights * slope_row);
   const Scalar line_variance =
-      line_row.dot(squared_weights.template topLeftCorner<2, 2>() * line_row);
-  if (line_variance > 0) result.error_ratio = sqrt(quadratic_variance / line_variance);
+      line_row.dot(design->squared_weights.template topLeftCorner<2, 2>() * line_row);
+  if (line_variance > 0) result.error_ratio = sqrt(polynomial_variance / line_variance);
   return result;
 }
 
@@ -348,43 +401,28 @@ DerivativeTarget<G> five_point_target(const std::vector<typename G::Element>& f,
 }
 
 // The weight l of the observation at `covariate` in the local slope at
-// tau, in the window's weighted least-squares fit on (1, u, u^2)
-// (`quadratic`) or (1, u), u = t - tau: the slope is sum_j l_j y_j, with
-// l_j = w_j e_1^T M^{-1} z_j. 0 when the covariate is not in the window or
-// the design is singular.
+// tau, in the window's weighted least-squares fit on
+// (1, u, ..., u^degree), u = t - tau, at the largest degree up to `degree`
+// that the window supports (as polynomial_slope): the slope is
+// sum_j l_j y_j, with l_j = w_j e_1^T M^{-1} z_j. 0 when the covariate is
+// not in the window or not even the line's design is regular.
 template <class G>
 typename G::Scalar slope_weight(const LocalWindow<G>& window, typename G::Scalar tau,
-                                typename G::Scalar covariate, bool quadratic) {
+                                typename G::Scalar covariate, int degree) {
   using Scalar = typename G::Scalar;
-  using Matrix3 = Eigen::Matrix<Scalar, 3, 3>;
-  using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
-  using std::abs;
-  const std::size_t m = window.covariates.size();
-  const int size = quadratic && m >= 3 ? 3 : 2;
-  if (m < 2) return Scalar(0);
-  const Scalar scale =
-      std::max(abs(window.covariates.front() - tau), abs(window.covariates.back() - tau));
-  const auto design = [&](Scalar t) {
-    const Scalar u = (t - tau) / scale;
-    return Vector3(Scalar(1), u, size == 3 ? u * u : Scalar(0));
-  };
-  Matrix3 normal = Matrix3::Zero();
-  Scalar weight = 0;
-  bool found = false;
-  for (std::size_t i = 0; i < m; ++i) {
-    const Vector3 z = design(window.covariates[i]);
-    normal.noalias() += window.weights[i] * z * z.transpose();
-    if (!found && window.covariates[i] == covariate) {
-      weight = window.weights[i];
-      found = true;
-    }
+  using Vector4 = Eigen::Matrix<Scalar, 4, 1>;
+  if (window.covariates.size() < 2) return Scalar(0);
+  const auto found = std::find(window.covariates.begin(), window.covariates.end(), covariate);
+  if (found == window.covariates.end()) return Scalar(0);
+  const Scalar weight = window.weights[static_cast<std::size_t>(found - window.covariates.begin())];
+  std::optional<local_regression_detail::PolynomialDesign<G>> design;
+  std::optional<SmallLU<Eigen::Matrix<Scalar, 4, 4>>> lu;
+  if (local_regression_detail::supported_degree<G>(window, tau, std::max(degree, 1), design, lu) <
+      1) {
+    return Scalar(0);
   }
-  if (!found) return Scalar(0);
-  if (size == 2) normal(2, 2) = Scalar(1);  // the unused quadratic column
-  const SmallLU<Matrix3> lu(normal);
-  if (!lu.invertible()) return Scalar(0);
-  const Vector3 row = lu.solve(Vector3::UnitY());
-  return weight * row.dot(design(covariate)) / scale;
+  const Vector4 row = lu->solve(Vector4::UnitY());
+  return weight * row.dot(design->row(covariate)) / design->scale;
 }
 
 }  // namespace bireg
