@@ -40,6 +40,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using bireg_test::data;
+using bireg_test::json_numbers;
+using bireg_test::json_string;
 using bireg_test::Run;
 using bireg_test::slurp;
 using bireg_test::work_dir;
@@ -48,40 +50,6 @@ bool json_has_non_finite(const std::string& json);
 
 Run run_tool(const std::string& arguments) {
   return bireg_test::run_executable(BIREG_FIT_EXECUTABLE, arguments);
-}
-
-// The numbers of the JSON value after "key": (a number or nested arrays),
-// in order. Enough for the flat object bireg_fit prints.
-std::vector<double> json_numbers(const std::string& json, const std::string& key) {
-  const std::size_t at = json.find("\"" + key + "\":");
-  REQUIRE(at != std::string::npos);
-  std::size_t i = at + key.size() + 3;
-  std::vector<double> numbers;
-  int depth = 0;
-  do {
-    while (json[i] == ' ' || json[i] == ',' || json[i] == '\n')
-      ++i;
-    if (json[i] == '[') {
-      ++depth;
-      ++i;
-    } else if (json[i] == ']') {
-      --depth;
-      ++i;
-    } else {
-      char* end = nullptr;
-      numbers.push_back(std::strtod(json.c_str() + i, &end));
-      REQUIRE(end != json.c_str() + i);
-      i = static_cast<std::size_t>(end - json.c_str());
-    }
-  } while (depth > 0);
-  return numbers;
-}
-
-std::string json_string(const std::string& json, const std::string& key) {
-  const std::size_t at = json.find("\"" + key + "\": \"");
-  REQUIRE(at != std::string::npos);
-  const std::size_t start = at + key.size() + 5;
-  return json.substr(start, json.find('"', start) - start);
 }
 
 template <class G>

@@ -1,7 +1,7 @@
 // Running a built command-line tool from a test: its exit code, stdout and
 // stderr, and the test's scratch and data directories (BIREG_TEST_WORK_DIR,
-// BIREG_TEST_DATA_DIR, set by tests/CMakeLists.txt). Shared by the tests of
-// bireg_fit and bireg_smooth.
+// BIREG_TEST_DATA_DIR, set by tests/CMakeLists.txt), and reading numbers
+// and strings out of their JSON. Shared by the tests of the tools.
 #pragma once
 
 #include <sys/wait.h>
@@ -12,6 +12,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "catch.hpp"
 
 namespace bireg_test {
 
@@ -51,6 +54,40 @@ inline Run run_executable(const std::string& executable, const std::string& argu
   run.out = slurp(out);
   run.err = slurp(err);
   return run;
+}
+
+// The numbers of the JSON value after "key": (a number or nested arrays),
+// in order. Enough for the objects the tools print (the first "key" in the text).
+inline std::vector<double> json_numbers(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\":");
+  REQUIRE(at != std::string::npos);
+  std::size_t i = at + key.size() + 3;
+  std::vector<double> numbers;
+  int depth = 0;
+  do {
+    while (json[i] == ' ' || json[i] == ',' || json[i] == '\n')
+      ++i;
+    if (json[i] == '[') {
+      ++depth;
+      ++i;
+    } else if (json[i] == ']') {
+      --depth;
+      ++i;
+    } else {
+      char* end = nullptr;
+      numbers.push_back(std::strtod(json.c_str() + i, &end));
+      REQUIRE(end != json.c_str() + i);
+      i = static_cast<std::size_t>(end - json.c_str());
+    }
+  } while (depth > 0);
+  return numbers;
+}
+
+inline std::string json_string(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\": \"");
+  REQUIRE(at != std::string::npos);
+  const std::size_t start = at + key.size() + 5;
+  return json.substr(start, json.find('"', start) - start);
 }
 
 }  // namespace bireg_test

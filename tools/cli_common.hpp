@@ -267,6 +267,24 @@ inline std::optional<std::string> write_text_file(const std::string& path,
   return std::nullopt;
 }
 
+// A JSON string literal (quotes, backslashes and control characters escaped).
+inline std::string json_text(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
 // A CSV field: as it is, or in double quotes (inner quotes doubled) when it
 // holds a comma, a quote or a line break.
 inline std::string csv_field(const std::string& text) {

@@ -15,4 +15,7 @@ int fit_main(int argc, char** argv);
 // bireg_smooth (tools/bireg_smooth.cpp documents the options and exit codes).
 int smooth_main(int argc, char** argv);
 
+// bireg_compare (tools/bireg_compare.cpp documents the options and exit codes).
+int compare_main(int argc, char** argv);
+
 }  // namespace bireg_cli

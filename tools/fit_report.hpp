@@ -30,6 +30,7 @@
 #include "bireg/statistics/inference/explained_variance.hpp"
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
+#include "cli_common.hpp"
 
 namespace bireg_fit_report {
 
@@ -70,23 +71,7 @@ std::vector<Coordinate> coordinates() {
   return layout;
 }
 
-// A JSON string literal (quotes, backslashes and control characters escaped).
-inline std::string json_text(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
+using bireg_cli::json_text;
 
 template <class Vector>
 std::string json_vector(const Vector& v) {
