@@ -135,6 +135,48 @@ TEST_CASE("A cubic angle's rate: exact with the local cubic, biased with the qua
   }
 }
 
+// select_bandwidth's cubic curve comes from the quadratic's held-out fits
+// (held_out with `cubic`): the same errors and c_i as separate passes of a
+// quadratic and of a cubic smoother. Both regress the same local
+// geodesic's residuals; the shared pass rebuilds that geodesic from its
+// pose and velocity, which moves the residuals by rounding (~1e-15 rad),
+// their slopes by that over the window's half-width (~1e-13 rad/s), far
+// below 1e-9.
+TEST_CASE("The cubic's held-out velocities from the shared fits equal a cubic smoother's") {
+  const bireg_test::So3Trajectory data = bireg_test::dense_so3_trajectory(300, 0.01, 17);
+  for (const bireg::HoldOut mode : {bireg::HoldOut::chords, bireg::HoldOut::derivatives}) {
+    auto options = local_options<SO3>(bireg::Kernel::gaussian, 0.03);
+    options.standard_errors = false;
+    bireg::HeldOut<SO3> cubic;
+    const auto shared =
+        bireg::LocalGeodesicRegression<SO3>(options).held_out(data.f, data.t, mode, &cubic);
+    const auto quadratic =
+        bireg::LocalGeodesicRegression<SO3>(options).held_out(data.f, data.t, mode);
+    options.velocity_degree = 3;
+    const auto separate =
+        bireg::LocalGeodesicRegression<SO3>(options).held_out(data.f, data.t, mode);
+    REQUIRE(shared.problem.empty());
+    REQUIRE(cubic.problem.empty());
+    REQUIRE(shared.ok == quadratic.ok);
+    REQUIRE(cubic.ok == separate.ok);
+    CHECK(cubic.failures == separate.failures);
+    std::size_t compared = 0;
+    for (std::size_t i = 0; i < data.t.size(); ++i) {
+      if (!cubic.ok[i]) continue;
+      ++compared;
+      CHECK((shared.errors[i] - quadratic.errors[i]).norm() < 1e-9);
+      CHECK((cubic.errors[i] - separate.errors[i]).norm() < 1e-9);
+      CHECK(std::abs(shared.cross[i] - quadratic.cross[i]) <
+            1e-9 * std::abs(quadratic.cross[i]) + 1e-12);
+      CHECK(std::abs(cubic.cross[i] - separate.cross[i]) <
+            1e-9 * std::abs(separate.cross[i]) + 1e-12);
+      // The two degrees differ: the comparison is not of one curve with itself.
+      if (i == data.t.size() / 2) CHECK((cubic.errors[i] - shared.errors[i]).norm() > 1e-6);
+    }
+    CHECK(compared > data.t.size() - 10);
+  }
+}
+
 TEST_CASE("Noise-free geodesic data are recovered at every bandwidth") {
   std::mt19937 rng(7);
   const std::vector<double> t = irregular_covariates(rng, 80);

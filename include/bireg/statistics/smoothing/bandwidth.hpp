@@ -348,8 +348,8 @@ HoldOut velocity_target(const Observations& observations, const Covariates& cova
 // constant that depends on neither. Set velocity_degree to 1 or 3 to fix
 // the degree. `progress`, when set, is called with (done, total) after
 // the pose's and after the velocity's held-out passes (2 per grid value).
-// Cost: two local fits per observation per grid value evaluated (three
-// with the cubic's curve), each over its window; windows are capped in turn
+// Cost: two local fits per observation per grid value evaluated (the
+// cubic's curve shares the velocity's), each over its window; windows are capped in turn
 // (Options::max_turn) and in the kernel's support, and the values past
 // both curves' minima are skipped (below), so the widest values, O(N^2)
 // each on slow motion over a long range, are seldom reached.
@@ -426,13 +426,12 @@ BandwidthSelection<typename G::Scalar> select_bandwidth(
             observations, covariates, noise, options.max_turn);
         noise_ready = true;
       }
-      velocities.push_back(smoother.held_out(observations, covariates, selection.velocity_target));
+      HeldOut<G> cubic;
+      velocities.push_back(smoother.held_out(observations, covariates, selection.velocity_target,
+                                             try_cubic ? &cubic : nullptr));
       Scalar velocity = provisional(velocities.back(), &noise);
       if (try_cubic) {
-        LocalRegressionOptions<Scalar> cubic_options = options;
-        cubic_options.velocity_degree = 3;
-        cubics.push_back(LocalGeodesicRegression<G>(cubic_options)
-                             .held_out(observations, covariates, selection.velocity_target));
+        cubics.push_back(std::move(cubic));
         velocity = std::min(velocity, provisional(cubics.back(), &noise));
       }
       if (progress) progress(2 * j + 2, 2 * k);

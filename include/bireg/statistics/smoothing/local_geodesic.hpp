@@ -309,13 +309,42 @@ class LocalGeodesicRegression {
   // l_j over its five observations; where it is undefined (the two first
   // and last observations, a turn past max_turn) the chord stands in.
   // Both kinds of error are left invariant and map by
-  // Ad_{h^{-1}} under right translation by h.
+  // Ad_{h^{-1}} under right translation by h. `cubic` (velocity modes, not
+  // robust): also the errors and c_i of the local cubic's velocity
+  // (velocity_degree 3) from the same held-out fits, the local geodesic's
+  // residuals regressed on both designs (select_bandwidth's second curve).
   template <class Observations, class Covariates>
-  HeldOut<G> held_out(const Observations& observations, const Covariates& covariates,
-                      HoldOut mode) const {
+  HeldOut<G> held_out(const Observations& observations, const Covariates& covariates, HoldOut mode,
+                      HeldOut<G>* cubic = nullptr) const {
     HeldOut<G> held;
     held.problem = refusal(observations, covariates, {});
-    if (!held.problem.empty()) return held;
+    if (cubic) *cubic = HeldOut<G>();
+    if (!held.problem.empty() || mode == HoldOut::one || options_.robust) {
+      if (cubic) cubic->problem = held.problem.empty() ? "not a velocity's" : held.problem;
+      if (!held.problem.empty()) return held;
+      cubic = nullptr;
+    }
+    if (cubic) {
+      // The fits without a correction, the two degrees' added below.
+      Options linear_options = options_;
+      linear_options.velocity_degree = 1;
+      HeldOut<G> held_cubic;
+      held =
+          LocalGeodesicRegression(linear_options)
+              .held_out_pass(observations, covariates, mode, options_.velocity_degree, &held_cubic);
+      *cubic = std::move(held_cubic);
+      return held;
+    }
+    return held_out_pass(observations, covariates, mode, options_.velocity_degree, nullptr);
+  }
+
+ private:
+  // held_out() after the refusal; `degree` the velocity's, and with `cubic`
+  // (then this smoother's own degree is 1) the local cubic's as well.
+  template <class Observations, class Covariates>
+  HeldOut<G> held_out_pass(const Observations& observations, const Covariates& covariates,
+                           HoldOut mode, int degree, HeldOut<G>* cubic) const {
+    HeldOut<G> held;
     const std::size_t n = observations.size();
     std::vector<std::size_t> order;
     std::vector<Scalar> sorted_t;
@@ -324,8 +353,13 @@ class LocalGeodesicRegression {
     held.errors.assign(n, Tangent::Zero());
     held.ok.assign(n, 0);
     if (mode != HoldOut::one) held.cross.assign(n, Scalar(0));
+    if (cubic) {
+      cubic->errors.assign(n, Tangent::Zero());
+      cubic->ok.assign(n, 0);
+      cubic->cross.assign(n, Scalar(0));
+    }
     // Robust queries report the robust geodesic's velocity.
-    const int degree = options_.robust ? 1 : options_.velocity_degree;
+    if (options_.robust) degree = 1;
     // Per block, its first failure: the first block's that is set is the
     // serial loop's.
     std::vector<std::string> block_failures(block_count(n));
@@ -373,31 +407,56 @@ class LocalGeodesicRegression {
         held.ok[order[i]] = 1;
         if (mode == HoldOut::one) {
           held.errors[order[i]] = G::log(G::compose(G::inverse(estimate.pose), sorted_f[i]));
-        } else {
-          const Window& used = estimate.widened ? windows.wide : windows.narrow;
-          held.errors[order[i]] = estimate.velocity - target;
-          Scalar cross = 0;
-          const auto slope_weight_of = [&](Scalar covariate) {
-            return slope_weight<G>(used, tau, covariate, degree);
-          };
-          if (five.defined) {
-            for (std::size_t k = 0; k < 5; ++k)
-              cross += five.weights[k] * slope_weight_of(sorted_t[i - 2 + k]);
-          } else {
-            cross = (slope_weight_of(sorted_t[i + 1]) - slope_weight_of(sorted_t[i - 1])) /
-                    (sorted_t[i + 1] - sorted_t[i - 1]);
-          }
-          held.cross[order[i]] = cross;
+          continue;
         }
+        const Window& used = estimate.widened ? windows.wide : windows.narrow;
+        // c_i for the velocity of degree p: the weights of the five-point
+        // target's (or the chord's) observations in the local slope.
+        const auto cross_of = [&](int p) {
+          const SlopeWeights<G> weight(used, tau, p);
+          if (!five.defined) {
+            return (weight(sorted_t[i + 1]) - weight(sorted_t[i - 1])) /
+                   (sorted_t[i + 1] - sorted_t[i - 1]);
+          }
+          Scalar cross = 0;
+          for (std::size_t k = 0; k < 5; ++k)
+            cross += five.weights[k] * weight(sorted_t[i - 2 + k]);
+          return cross;
+        };
+        if (!cubic) {
+          held.errors[order[i]] = estimate.velocity - target;
+          held.cross[order[i]] = cross_of(degree);
+          continue;
+        }
+        // The uncorrected local geodesic through the estimate (its pose at
+        // tau, its body velocity) and its residuals' two polynomial slopes.
+        const Element pose = estimate.pose;
+        const Tangent velocity = estimate.velocity;
+        const auto local = [&](Scalar t) { return G::compose(pose, G::exp((t - tau) * velocity)); };
+        const auto corrected = [&](int p) {
+          if (p < 2) return velocity;
+          const PolynomialSlope<G> slope = polynomial_slope<G>(local, used, tau, p);
+          return slope.defined ? Tangent(velocity + slope.slope) : velocity;
+        };
+        held.errors[order[i]] = corrected(degree) - target;
+        held.cross[order[i]] = cross_of(degree);
+        cubic->ok[order[i]] = 1;
+        cubic->errors[order[i]] = corrected(3) - target;
+        cubic->cross[order[i]] = cross_of(3);
       }
     });
     for (std::size_t block = 0; block < block_failures.size(); ++block) {
       held.failures += block_counts[block];
       if (held.first_failure.empty()) held.first_failure = std::move(block_failures[block]);
     }
+    if (cubic) {
+      cubic->failures = held.failures;
+      cubic->first_failure = held.first_failure;
+    }
     return held;
   }
 
+ public:
   // Why smooth_at() would refuse these inputs (each of its estimates then
   // carries this message), or empty: the options, the lengths, the
   // observations (check_observations) and every covariate and query

@@ -400,29 +400,43 @@ DerivativeTarget<G> five_point_target(const std::vector<typename G::Element>& f,
   return target;
 }
 
-// The weight l of the observation at `covariate` in the local slope at
-// tau, in the window's weighted least-squares fit on
-// (1, u, ..., u^degree), u = t - tau, at the largest degree up to `degree`
-// that the window supports (as polynomial_slope): the slope is
-// sum_j l_j y_j, with l_j = w_j e_1^T M^{-1} z_j. 0 when the covariate is
-// not in the window or not even the line's design is regular.
+// The weights l of the observations in the local slope at tau, in the
+// window's weighted least-squares fit on (1, u, ..., u^degree),
+// u = t - tau, at the largest degree up to `degree` that the window
+// supports (as polynomial_slope): the slope is sum_j l_j y_j, with
+// l_j = w_j e_1^T M^{-1} z_j. The design is factored once; a covariate
+// not in the window, or a window where not even the line's design is
+// regular, has weight 0.
 template <class G>
-typename G::Scalar slope_weight(const LocalWindow<G>& window, typename G::Scalar tau,
-                                typename G::Scalar covariate, int degree) {
+class SlopeWeights {
+ public:
   using Scalar = typename G::Scalar;
-  using Vector4 = Eigen::Matrix<Scalar, 4, 1>;
-  if (window.covariates.size() < 2) return Scalar(0);
-  const auto found = std::find(window.covariates.begin(), window.covariates.end(), covariate);
-  if (found == window.covariates.end()) return Scalar(0);
-  const Scalar weight = window.weights[static_cast<std::size_t>(found - window.covariates.begin())];
-  std::optional<local_regression_detail::PolynomialDesign<G>> design;
-  std::optional<SmallLU<Eigen::Matrix<Scalar, 4, 4>>> lu;
-  if (local_regression_detail::supported_degree<G>(window, tau, std::max(degree, 1), design, lu) <
-      1) {
-    return Scalar(0);
+
+  SlopeWeights(const LocalWindow<G>& window, Scalar tau, int degree) : window_(window) {
+    if (window.covariates.size() < 2) return;
+    std::optional<SmallLU<Eigen::Matrix<Scalar, 4, 4>>> lu;
+    if (local_regression_detail::supported_degree<G>(window, tau, std::max(degree, 1), design_,
+                                                     lu) < 1) {
+      return;
+    }
+    slope_row_ = lu->solve(Eigen::Matrix<Scalar, 4, 1>::UnitY());
+    regular_ = true;
   }
-  const Vector4 row = lu->solve(Vector4::UnitY());
-  return weight * row.dot(design->row(covariate)) / design->scale;
-}
+
+  Scalar operator()(Scalar covariate) const {
+    if (!regular_) return Scalar(0);
+    const auto& t = window_.covariates;
+    const auto found = std::find(t.begin(), t.end(), covariate);
+    if (found == t.end()) return Scalar(0);
+    const Scalar weight = window_.weights[static_cast<std::size_t>(found - t.begin())];
+    return weight * slope_row_.dot(design_->row(covariate)) / design_->scale;
+  }
+
+ private:
+  const LocalWindow<G>& window_;
+  std::optional<local_regression_detail::PolynomialDesign<G>> design_;
+  Eigen::Matrix<Scalar, 4, 1> slope_row_ = Eigen::Matrix<Scalar, 4, 1>::Zero();
+  bool regular_ = false;
+};
 
 }  // namespace bireg
