@@ -71,7 +71,7 @@ Velocities auto_velocity(const RotationTrack& track) {
 // one-sided slope adds variance and removes no bias) closed when the
 // velocity's degree came to be chosen with its bandwidth (DESIGN.md
 // section 5, "The velocity's degree"): the local cubic at about twice the
-// bandwidth is 0.89-0.99x the chart line there.
+// bandwidth is 0.89-1.02x the chart line there.
 struct Gap {
   const char* name;
   const char* bound;
