@@ -153,7 +153,7 @@ TEST_CASE("bireg_compare --elements: the library's test, any thread count", "[to
 // The invariant variant does not depend on which cohort is A (docs/cohorts.md
 // proves it): the manifest listing grade 3 first gives the same statistic.
 TEST_CASE("bireg_compare: naming the other cohort first leaves the statistic", "[tool]") {
-  double values[2];
+  double values[2] = {0.0, 0.0};
   for (const bool b_first : {false, true}) {
     const ElementStudy study = element_study(b_first);
     const Run run = run_tool("--group SE3 --elements --permutations 0 " + quoted(study.manifest));

@@ -83,8 +83,10 @@ Eigen::Vector2d slow_eigenvector(const std::vector<double>& t, double mu_min) {
 
 template <class G>
 bool all_finite(const typename bireg::GeodesicRegression<G>::Result& result) {
-  return result.geodesic->start().allFinite() && result.geodesic->end().allFinite() &&
-         std::isfinite(result.diagnostics.residual_rms) &&
+  // A refused fit has no geodesic; what it has must still be finite.
+  const bool geodesic_finite = !result.geodesic || (result.geodesic->start().allFinite() &&
+                                                    result.geodesic->end().allFinite());
+  return geodesic_finite && std::isfinite(result.diagnostics.residual_rms) &&
          std::isfinite(result.diagnostics.explained_variance);
 }
 

@@ -20,13 +20,15 @@ constexpr Scalar eps() {
   return std::numeric_limits<Scalar>::epsilon();
 }
 
-// A tangent vector with independent N(0, sd^2) coordinates.
+// A tangent vector with independent N(0, sd^2) coordinates; sd = 0 gives
+// zero (std::normal_distribution requires sd > 0: _GLIBCXX_ASSERTIONS
+// aborts on 0). The same draws as normal_distribution(0, sd) for sd > 0.
 template <class Tangent>
 Tangent normal_tangent(std::mt19937& rng, double sd) {
-  std::normal_distribution<double> normal(0.0, sd);
+  std::normal_distribution<double> standard(0.0, 1.0);
   Tangent x;
   for (int i = 0; i < x.size(); ++i)
-    x[i] = normal(rng);
+    x[i] = sd * standard(rng);
   return x;
 }
 
