@@ -178,6 +178,13 @@ template <class G, class Observations>
 std::optional<Rejection> check_input(const Observations& observations,
                                      const std::vector<double>& times, int threads) {
   if (auto rejection = check_covariates(observations.size(), times)) return rejection;
+  // One observation has no residual scatter for any candidate: refused
+  // here, where the reason can be said, rather than every candidate
+  // excluded and no_candidate reported.
+  if (observations.size() < 2) {
+    return Rejection{"model selection needs at least 2 observations, got " +
+                     std::to_string(observations.size())};
+  }
   if (threads < 1) return Rejection{"threads must be at least 1, got " + std::to_string(threads)};
   return check_observations<G>(observations, default_element_tolerance<typename G::Scalar>());
 }
