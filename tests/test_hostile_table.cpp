@@ -39,6 +39,7 @@
 #include "bireg/statistics/smoothing/bandwidth.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
 #include "catch.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -90,16 +91,13 @@ struct Input {
 template <class G>
 Input<G> valid_input() {
   std::mt19937 rng(37);
-  std::normal_distribution<double> normal(0.0, 0.05);
   typename G::Tangent x;
   for (int k = 0; k < G::dof; ++k)
     x[k] = 0.4 - 0.07 * k;
   Input<G> in;
   const int n = 16;
   for (int i = 0; i < n; ++i) {
-    typename G::Tangent e;
-    for (int k = 0; k < G::dof; ++k)
-      e[k] = normal(rng);
+    const auto e = bireg_test::normal_tangent<typename G::Tangent>(rng, 0.05);
     const double s = i / double(n - 1);
     in.f.push_back(G::compose(G::exp(typename G::Tangent(s * x)), G::exp(e)));
     in.t.push_back(0.1 * i);
@@ -108,53 +106,47 @@ Input<G> valid_input() {
   return in;
 }
 
-// The input classes, the table's columns, in its order.
+// The input classes, keyed by the table's column names.
 template <class G>
 std::map<std::string, Input<G>> input_classes() {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   constexpr double inf = std::numeric_limits<double>::infinity();
   const Input<G> valid = valid_input<G>();
   std::map<std::string, Input<G>> classes;
-  classes["valid"] = valid;
-  classes["nan_obs"] = valid;
-  classes["nan_obs"].f[3](0, 1) = nan;
-  classes["inf_obs"] = valid;
-  classes["inf_obs"].f[3](0, 1) = inf;
+  // `valid` with one change.
+  const auto variant = [&](const std::string& name, const auto& change) {
+    Input<G> in = valid;
+    change(in);
+    classes[name] = std::move(in);
+  };
+  const auto each = [](std::vector<double>& values, const auto& value_at) {
+    for (std::size_t i = 0; i < values.size(); ++i)
+      values[i] = value_at(double(i));
+  };
+  variant("valid", [](Input<G>&) {});
+  variant("nan_obs", [&](Input<G>& in) { in.f[3](0, 1) = nan; });
+  variant("inf_obs", [&](Input<G>& in) { in.f[3](0, 1) = inf; });
   // Determinant -1 (SO3, SE3's rotation) or negative (GL+(3)).
-  classes["non_element"] = valid;
-  classes["non_element"].f[3].row(0) *= -1.0;
+  variant("non_element", [](Input<G>& in) { in.f[3].row(0) *= -1.0; });
   classes["empty"] = Input<G>{};
-  classes["single"] = valid;
-  classes["single"].f.resize(1);
-  classes["single"].t.resize(1);
-  classes["single"].w.resize(1);
-  classes["nan_cov"] = valid;
-  classes["nan_cov"].t[3] = nan;
-  classes["inf_cov"] = valid;
-  classes["inf_cov"].t[3] = inf;
-  classes["equal_cov"] = valid;
-  for (double& t : classes["equal_cov"].t)
-    t = 2.0;
+  variant("single", [](Input<G>& in) {
+    in.f.resize(1);
+    in.t.resize(1);
+    in.w.resize(1);
+  });
+  variant("nan_cov", [&](Input<G>& in) { in.t[3] = nan; });
+  variant("inf_cov", [&](Input<G>& in) { in.t[3] = inf; });
+  variant("equal_cov", [&](Input<G>& in) { each(in.t, [](double) { return 2.0; }); });
   // A range double holds but a velocity over it does not (1.5e-299).
-  classes["tiny_range"] = valid;
-  for (std::size_t i = 0; i < valid.t.size(); ++i)
-    classes["tiny_range"].t[i] = 1e-300 * double(i);
+  variant("tiny_range", [&](Input<G>& in) { each(in.t, [](double i) { return 1e-300 * i; }); });
   // EuRoC nanoseconds as doubles: the same data, 5 ms apart, at 1.4e18.
-  classes["ns_offset"] = valid;
-  for (std::size_t i = 0; i < valid.t.size(); ++i)
-    classes["ns_offset"].t[i] = 1.4e18 + 5e6 * double(i);
-  classes["short_cov"] = valid;
-  classes["short_cov"].t.pop_back();
-  classes["neg_weight"] = valid;
-  classes["neg_weight"].w[3] = -1.0;
-  classes["nan_weight"] = valid;
-  classes["nan_weight"].w[3] = nan;
-  classes["zero_weights"] = valid;
-  for (double& w : classes["zero_weights"].w)
-    w = 0.0;
-  classes["huge_weights"] = valid;
-  for (double& w : classes["huge_weights"].w)
-    w = 1e308;
+  variant("ns_offset",
+          [&](Input<G>& in) { each(in.t, [](double i) { return 1.4e18 + 5e6 * i; }); });
+  variant("short_cov", [](Input<G>& in) { in.t.pop_back(); });
+  variant("neg_weight", [](Input<G>& in) { in.w[3] = -1.0; });
+  variant("nan_weight", [&](Input<G>& in) { in.w[3] = nan; });
+  variant("zero_weights", [&](Input<G>& in) { each(in.w, [](double) { return 0.0; }); });
+  variant("huge_weights", [&](Input<G>& in) { each(in.w, [](double) { return 1e308; }); });
   return classes;
 }
 
