@@ -55,12 +55,11 @@
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
 #include "bireg/statistics/selection/model_selection.hpp"
+#include "require.hpp"
 
 namespace {
 
-void require(bool condition) {
-  if (!condition) std::abort();
-}
+using bireg_fuzz::require;
 
 std::uint64_t count_lines(const std::string& text) {
   std::uint64_t lines = 1;

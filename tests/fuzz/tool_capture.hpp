@@ -20,11 +20,9 @@
 
 #include <unistd.h>
 
-namespace bireg_fuzz {
+#include "require.hpp"
 
-inline void require(bool condition) {
-  if (!condition) std::abort();
-}
+namespace bireg_fuzz {
 
 struct ToolRun {
   int exit_code = 0;

@@ -574,6 +574,20 @@ class LocalGeodesicRegression {
       widen(windows.wide, estimate);
     }
     refuse_unrepresentable(estimate);
+    explain_failure(estimate);
+  }
+
+  // A failed estimate says why. fit() keeps its message for refusals, so a
+  // local fit's own failure (no_descent, max_iterations, ...) is named here
+  // with the query and the window.
+  static void explain_failure(Estimate& estimate) {
+    if (estimate.ok() || !estimate.message.empty()) return;
+    const char* how = is_success(estimate.status) && estimate.robust_status
+                          ? to_string(*estimate.robust_status)
+                          : to_string(estimate.status);
+    estimate.message = "the local fit at " + std::to_string(double(estimate.covariate)) +
+                       " ended " + how + " (" + std::to_string(estimate.window) +
+                       " observations in its window)";
   }
 
   // Never a number where the computation failed: an estimate whose pose or
