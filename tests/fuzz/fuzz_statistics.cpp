@@ -135,9 +135,10 @@ void exercise(FuzzedDataProvider& in, bireg::Solver solver) {
   const auto fit = regression.fit(f, t, w);
   if (fit.ok()) {
     require_finite_fit(fit, t);
-    // Flavours 0 and 1, and a value outside the enumeration.
+    // Homoscedastic, robust, or a value outside the enumeration.
+    const int flavour_value = in.ConsumeIntegralInRange(0, 2);
     const auto flavour =
-        static_cast<bireg::CovarianceFlavour>(in.ConsumeIntegralInRange<int>(0, 2) * 3 % 7);
+        static_cast<bireg::CovarianceFlavour>(flavour_value == 2 ? 7 : flavour_value);
     const auto c = bireg::covariance(fit, t, w, flavour);
     if (c.status == bireg::CovarianceStatus::invalid_input) {
       require_message(c.message);
