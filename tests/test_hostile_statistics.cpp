@@ -296,6 +296,23 @@ TEST_CASE(
   REQUIRE(bireg::bandwidth_grid(std::vector<double>{0, 1, nan, 3}).empty());
   // The widest value is the covariates' range exactly.
   REQUIRE(bireg::bandwidth_grid(plain).back() == 5);
+  // Ranges that span more than a double's exponent from the narrowest to
+  // the widest value (found by fuzz_local_regression): every value is
+  // representable, though the ratio of the two ends is not. A median
+  // spacing of 1e-20 under a range of 1e308 (auto grid: 5e-21 to 1e308, a
+  // ratio of e^756), and a narrowest value of 1e-300 spacings.
+  const std::vector<double> spanning{0, 1e-20, 2e-20, 3e-20, big};
+  const std::vector<double> fuzzed{-std::numeric_limits<double>::max(), -21.2, -20.5, -19.1, 31.75};
+  for (const auto& grid : {bireg::auto_bandwidth_grid(spanning), bireg::bandwidth_grid(spanning, 7),
+                           bireg::bandwidth_grid(fuzzed, 4, 1e-300)}) {
+    CAPTURE(grid);
+    REQUIRE(grid.size() >= 4);
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+      REQUIRE(std::isfinite(grid[k]));
+      REQUIRE(grid[k] > 0);
+      if (k > 0) REQUIRE(grid[k] > grid[k - 1]);
+    }
+  }
 
   const auto f = noisy_line<SO3d>(6, 0.01, 6);
   const bireg::LocalRegressionOptions<double> options;

@@ -558,10 +558,19 @@ std::vector<double> bandwidth_grid(const Covariates& covariates, int count = 20,
   const double high = t.back() - t.front();
   if (!std::isfinite(high) || !std::isfinite(low) || !(low > 0)) return {};
   if (!(high > low)) return {high};
+  // low (high / low)^(k / (count - 1)), from the logarithms: high / low
+  // may overflow. Where its power does too (low 1e-301, high 1e308: every
+  // value of the grid is a double, the ratio of its ends is not), the same
+  // value from log low. (Not everywhere: the rounding differs, and the
+  // selection's near-ties at covariates of 1e18 would follow it.)
   std::vector<double> grid(static_cast<std::size_t>(count));
-  const double ratio = (std::log(high) - std::log(low)) / (count - 1);  // high / low may overflow
-  for (int k = 0; k < count; ++k)
-    grid[static_cast<std::size_t>(k)] = low * std::exp(ratio * k);
+  const double log_low = std::log(low);
+  const double ratio = (std::log(high) - log_low) / (count - 1);
+  for (int k = 0; k < count; ++k) {
+    const double power = std::exp(ratio * k);
+    const double value = std::isfinite(power) ? low * power : std::exp(log_low + ratio * k);
+    grid[static_cast<std::size_t>(k)] = std::clamp(value, low, high);
+  }
   grid.back() = high;  // exp(log(high / low)) may round past the range
   return grid;
 }
