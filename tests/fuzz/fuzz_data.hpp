@@ -11,7 +11,8 @@
 //   * n observations (0..max_n) exp(x0) exp(s_i x) exp(e_i), s_i = i/(n-1),
 //     e_i Gaussian with a standard deviation from the input (the noise is
 //     drawn from a generator seeded by the input, so that an input is a few
-//     dozen bytes whatever n);
+//     dozen bytes whatever n; the standard library's distributions make
+//     an input's data set that library's: libstdc++ here, as in CI);
 //   * covariates: evenly spaced from t0 by dt (both from number(): either
 //     may be hostile), shuffled, or drawn; then up to three covariates
 //     replaced by number(), and possibly one too few or one too many;
