@@ -330,10 +330,10 @@ bireg::io::Timestamp rate_timestamp(const bireg::io::Timestamp& origin, std::uin
   return t;
 }
 
-// Why a query failed, in one line.
+// Why a query failed, in one line (a failed estimate always says why).
 template <class G>
 std::string failure_reason(const bireg::LocalEstimate<G>& e) {
-  return e.message.empty() ? std::string(bireg::to_string(e.status)) : e.message;
+  return e.message;
 }
 
 // Writes the velocity CSV (header t, the tangent coordinates, se_ of each,

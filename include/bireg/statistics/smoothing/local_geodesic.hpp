@@ -393,11 +393,9 @@ class LocalGeodesicRegression {
         if (!estimate.ok()) {
           const std::size_t block = begin / kQueryBlock;
           if (block_counts[block]++ == 0) {
-            block_failures[block] =
-                "observation " + std::to_string(order[i]) +
-                (mode == HoldOut::one ? " left out: " : "'s chord: ") +
-                (estimate.message.empty() ? std::string(to_string(estimate.status))
-                                          : estimate.message);
+            block_failures[block] = "observation " + std::to_string(order[i]) +
+                                    (mode == HoldOut::one ? " left out: " : "'s chord: ") +
+                                    estimate.message;
           }
           continue;
         }
