@@ -3,8 +3,8 @@
 // and on the matrix groups (whose exp and log are fixed-size: no Schur
 // decomposition). The local regression allocates nothing per query:
 // smoothing 4x more observations allocates exactly as often. A result keeps
-// little unused history. Counted with a
-// replacement global operator new (this test is its own executable).
+// little unused history. Counted with a replacement global operator new
+// (this test is its own executable).
 #include <atomic>
 #include <cstdlib>
 #include <new>

@@ -330,12 +330,6 @@ bireg::io::Timestamp rate_timestamp(const bireg::io::Timestamp& origin, std::uin
   return t;
 }
 
-// Why a query failed, in one line (a failed estimate always says why).
-template <class G>
-std::string failure_reason(const bireg::LocalEstimate<G>& e) {
-  return e.message;
-}
-
 // Writes the velocity CSV (header t, the tangent coordinates, se_ of each,
 // status); a failed row has empty numbers and "failed: <reason>".
 // Returns "path: reason" when it cannot be written.
@@ -363,7 +357,7 @@ std::optional<std::string> write_velocity(const std::string& path,
       if (ok && e.velocity_error_defined) bireg::io::append_double(text, e.velocity_error[k]);
     }
     text += ',';
-    text += ok ? std::string("ok") : bireg_cli::csv_field("failed: " + failure_reason(e));
+    text += ok ? std::string("ok") : bireg_cli::csv_field("failed: " + e.message);
     text += '\n';
   }
   return bireg_cli::write_text_file(path, text);
@@ -654,7 +648,7 @@ int run(const Command& command) {
     if (!bad.ok()) {
       if (failed++ < kFailuresShown) {
         std::fprintf(stderr, "bireg_smooth: %s: failed (%s): %s\n", query_places[q].c_str(),
-                     &bad == &pose ? "pose" : "velocity", failure_reason(bad).c_str());
+                     &bad == &pose ? "pose" : "velocity", bad.message.c_str());
       }
     }
     if (!pose.ok()) continue;
