@@ -27,7 +27,8 @@
 struct UnitriangularBasis {
   static constexpr int dof = 3;
   static constexpr const char* name = "Unitriangular3";
-  static constexpr int nilpotency_order = 3;  // X^3 = 0: exp and log are polynomials
+  static constexpr int nilpotency_order = 3;             // X^3 = 0: exp and log are polynomials
+  static constexpr bool ad_spectrum_from_matrix = true;  // README "A matrix group of your own"
 
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {  // X = E01, Y = E12, Z = E02

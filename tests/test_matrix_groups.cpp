@@ -23,6 +23,7 @@
 
 #include "bireg/concept.hpp"
 #include "bireg/groups/matrix_group.hpp"
+#include "bireg/math/eigenvalue_spread.hpp"
 #include "bireg/math/matrix_functions.hpp"
 #include "bireg/math/psi_series.hpp"
 #include "bireg/regression.hpp"
@@ -126,6 +127,92 @@ TEST_CASE("Heisenberg: polynomial exp and log, nilpotent ad, terminating series"
       REQUIRE(relative_error(bireg::apply_psi<G>(x, s, r), first) <= 1e-15);
     }
   }
+}
+
+// The spectral radius of ad_x from the eigenvalues of X = hat x
+// (math/eigenvalue_spread.hpp): on matrices P D P^{-1} whose eigenvalues
+// are chosen, the spread is known by hand. Separated eigenvalues with P of
+// condition ~3: 1e-12 relative (a few hundred epsilon through P^{-1}, the
+// cubic's coefficients and acos/cbrt); a double eigenvalue, whose cubic
+// root moves by the square root of a rounding error: 1e-6 relative.
+TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[matrix_group]") {
+  using Matrix3 = Eigen::Matrix3d;
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> entry(-0.3, 0.3);
+  const auto similar = [&](const Matrix3& d) {
+    Matrix3 p;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        p(r, c) = (r == c ? 1.0 : 0.0) + entry(rng);
+    return Matrix3(p * d * p.inverse());
+  };
+  const auto rotation_block = [](double a, double b, double r) {
+    Matrix3 d = Matrix3::Zero();  // eigenvalues a +- i b and r
+    d << a, -b, 0, b, a, 0, 0, 0, r;
+    return d;
+  };
+  struct Case {
+    Matrix3 d;
+    double spread;
+    double tolerance;
+  };
+  const Case cases[] = {
+      {Eigen::Vector3d(0.3, -1.2, 2.0).asDiagonal(), 3.2, 1e-12},
+      {rotation_block(0.5, 2.0, -1.0), 4.0, 1e-12},                   // 2 b wins
+      {rotation_block(0.0, 0.5, 3.0), std::sqrt(9.0 + 0.25), 1e-12},  // |r - a -+ i b| wins
+      {rotation_block(7.0, 1.5, 7.0), 3.0, 1e-12},                    // a shift changes nothing
+      {Eigen::Vector3d(1.0, 1.0, -2.0).asDiagonal(), 3.0, 1e-6},      // a double eigenvalue
+  };
+  for (const Case& c : cases) {
+    for (double scale : {1.0, 1e150, 1e-150}) {
+      const Matrix3 x = similar(c.d) * scale;
+      CAPTURE(c.spread, scale);
+      REQUIRE(std::abs(bireg::math::eigenvalue_spread<double, 3>(x) / scale - c.spread) <=
+              c.tolerance * c.spread);
+    }
+  }
+  // Exactly 0: a multiple of the identity, a nilpotent Jordan block, zero.
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(Matrix3(4.0 * Matrix3::Identity())) == 0.0);
+  Matrix3 jordan = Matrix3::Zero();
+  jordan(0, 1) = jordan(1, 2) = 1.0;
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(jordan) == 0.0);
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(Matrix3(Matrix3::Zero())) == 0.0);
+  // 2 x 2: [1 2; 3 4] has (5 +- sqrt 33)/2; a rotation generator +- i theta.
+  REQUIRE(bireg::math::eigenvalue_spread<double, 2>((Eigen::Matrix2d() << 1, 2, 3, 4).finished()) ==
+          Approx(std::sqrt(33.0)).epsilon(1e-14));
+  REQUIRE(bireg::math::eigenvalue_spread<double, 2>(
+              (Eigen::Matrix2d() << 0, -0.7, 0.7, 0).finished()) == Approx(1.4).epsilon(1e-14));
+  // Not finite in, NaN out (callers test !(radius < limit)).
+  Matrix3 hostile = similar(cases[0].d);
+  hostile(1, 2) = std::numeric_limits<double>::quiet_NaN();
+  REQUIRE(std::isnan(bireg::math::eigenvalue_spread<double, 3>(hostile)));
+  hostile(1, 2) = std::numeric_limits<double>::infinity();
+  REQUIRE(std::isnan(bireg::math::eigenvalue_spread<double, 3>(hostile)));
+
+  // On the groups: GL+(3) takes any X, SL(3) its traceless part. The
+  // largest difference lambda_i - lambda_j is an eigenvalue of ad_x on the
+  // algebra itself: v_i w_j^T (v_i = P e_i, w_j^T = e_j^T P^{-1}) is in
+  // sl(3) for i != j and ad_x maps it to (lambda_i - lambda_j) v_i w_j^T.
+  const Eigen::Vector3d lambda(0.3, -1.2, 2.0);
+  Matrix3 p;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      p(r, c) = (r == c ? 1.0 : 0.0) + entry(rng);
+  const Matrix3 p_inverse = p.inverse();
+  const Matrix3 x = p * lambda.asDiagonal() * p_inverse;
+  using GL = bireg::GLp<3, double>;
+  REQUIRE(bireg::ad_spectral_radius<GL>(GL::vee(x)) == Approx(3.2).epsilon(1e-12));
+  using SL = bireg::SL3<double>;
+  const Matrix3 traceless = x - (x.trace() / 3.0) * Matrix3::Identity();
+  const SL::Tangent sl_x = SL::vee(traceless);
+  REQUIRE(bireg::ad_spectral_radius<SL>(sl_x) == Approx(3.2).epsilon(1e-12));
+  const Matrix3 rank_one = p.col(2) * p_inverse.row(1);  // i = 2 (2.0), j = 1 (-1.2)
+  const SL::Tangent v = SL::vee(rank_one);
+  REQUIRE(relative_error(SL::Algebra(SL::hat(v)), rank_one) <= 1e-14);  // in sl(3)
+  REQUIRE(relative_error(SL::Tangent(SL::ad(sl_x) * v), SL::Tangent(3.2 * v)) <= 1e-12);
+  // Heisenberg: X strictly upper triangular, ad_x nilpotent: both 0.
+  using H = bireg::Heisenberg<double>;
+  REQUIRE(bireg::ad_spectral_radius<H>(H::Tangent(0.4, -2.0, 5.0)) == 0.0);
 }
 
 // Extreme sizes: tangent vectors t u with u a random unit (Frobenius) algebra

@@ -5,7 +5,9 @@
 // that provides none still works everywhere:
 //
 //   Scalar ad_spectral_radius(const Tangent& x)     spectral radius of ad_x
-//       fallback: eigenvalues of the dof x dof matrix ad_x (fixed size).
+//       fallback: MatrixGroup's ad_spectral_radius_from_matrix where its
+//       basis allows (GL(N), SL(N), Heisenberg; N <= 3), else the
+//       eigenvalues of the dof x dof matrix ad_x (fixed size).
 //   AdMatrix right_jacobian(const Tangent& x)        J_r(x) = (1 - e^{-ad_x}) / ad_x
 //   AdMatrix right_jacobian_inverse(const Tangent& x)
 //       fallback: the power series in ad_x (J_r is entire; J_r^{-1} =
@@ -69,6 +71,9 @@ using Tangent = typename G::Tangent;
 template <class G>
 using ad_spectral_radius = decltype(G::ad_spectral_radius(std::declval<const Tangent<G>&>()));
 template <class G>
+using ad_spectral_radius_from_matrix =
+    decltype(G::ad_spectral_radius_from_matrix(std::declval<const Tangent<G>&>()));
+template <class G>
 using right_jacobian = decltype(G::right_jacobian(std::declval<const Tangent<G>&>()));
 template <class G>
 using right_jacobian_inverse =
@@ -112,6 +117,8 @@ template <class G>
 typename G::Scalar ad_spectral_radius(const typename G::Tangent& x) {
   if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
     return G::ad_spectral_radius(x);
+  } else if constexpr (provides_v<G, capability_detail::ad_spectral_radius_from_matrix>) {
+    return G::ad_spectral_radius_from_matrix(x);  // MatrixGroup's closed form
   } else {
     const typename G::AdMatrix a = G::ad(x);
     Eigen::EigenSolver<typename G::AdMatrix> solver(a, /*computeEigenvectors=*/false);

@@ -14,6 +14,7 @@
 //   template <class S> static bool is_element(const Eigen::Matrix<S, N, N>&, S tol);
 // and optionally
 //   static constexpr int nilpotency_order;          // p with X^p = 0 on the algebra
+//   static constexpr bool ad_spectrum_from_matrix;  // see ad_spectral_radius_from_matrix
 // (see HeisenbergBasis, SL3Basis, GLBasis below: a dozen lines each).
 //
 // Nilpotent algebras (unipotent groups such as Heisenberg): when every X in
@@ -54,6 +55,7 @@
 
 #include "bireg/groups/capabilities.hpp"
 #include "bireg/groups/tolerance.hpp"
+#include "bireg/math/eigenvalue_spread.hpp"
 #include "bireg/math/matrix_functions.hpp"
 
 namespace bireg {
@@ -65,6 +67,13 @@ struct nilpotency_order_of : std::integral_constant<int, 0> {};
 template <class Basis>
 struct nilpotency_order_of<Basis, std::void_t<decltype(Basis::nilpotency_order)>>
     : std::integral_constant<int, Basis::nilpotency_order> {};
+
+// Basis::ad_spectrum_from_matrix if declared, else false.
+template <class Basis, class = void>
+struct ad_spectrum_from_matrix_of : std::false_type {};
+template <class Basis>
+struct ad_spectrum_from_matrix_of<Basis, std::void_t<decltype(Basis::ad_spectrum_from_matrix)>>
+    : std::integral_constant<bool, Basis::ad_spectrum_from_matrix> {};
 
 // {0, 1, 1/2, ..., 1/(Count-1)} at compile time: the nilpotent series
 // multiply by these instead of dividing at run time.
@@ -165,6 +174,33 @@ struct MatrixGroup {
     return g.allFinite() && Basis::template is_element<Scalar>(g, tol);
   }
 
+  // Spectral radius of ad_x, for a 2 x 2 or 3 x 3 algebra whose Basis
+  // declares ad_spectrum_from_matrix = true: the largest difference of the
+  // eigenvalues of X = hat x, in closed form (math/eigenvalue_spread.hpp).
+  // capabilities.hpp's ad_spectral_radius<G> uses it instead of its
+  // fallback, a general eigensolver on the dof x dof matrix ad_x compiled
+  // for each size. (Under the name ad_spectral_radius it would also turn
+  // on the per-residual angle diagnostics of the fit and the spline for
+  // these groups: a change of their output, not made here.)
+  //
+  // Why the two agree there. The algebra g is an ad_X-invariant subspace of
+  // gl(N), so the eigenvalues of ad_X on g are some of its eigenvalues on
+  // gl(N), the differences lambda_i - lambda_j of X's eigenvalues. On
+  // gl(N) they are all of them. On sl(N), gl(N) = sl(N) + span(I) with
+  // ad_X I = 0, so only a 0 is lost and the largest modulus is kept. On
+  // strictly upper-triangular matrices (Heisenberg) X is nilpotent, so
+  // every lambda_i is 0, and ad_X is nilpotent (Engel's theorem): both are
+  // 0. A basis of some other subalgebra leaves the flag unset: there the
+  // largest difference may be missing from g and only bounds the radius.
+  template <
+      class T = Tangent,
+      std::enable_if_t<std::is_same_v<T, Tangent> &&
+                           detail::ad_spectrum_from_matrix_of<Basis>::value && (N == 2 || N == 3),
+                       int> = 0>
+  static Scalar ad_spectral_radius_from_matrix(const T& x) {
+    return math::eigenvalue_spread<Scalar, N>(hat(x));
+  }
+
  private:
   // The Horner steps T_K of the nilpotent series (see exp and log),
   // unrolled at compile time.
@@ -233,6 +269,7 @@ struct HeisenbergBasis {
   static constexpr int dof = 3;
   static constexpr const char* name = "Heisenberg";
   static constexpr int nilpotency_order = 3;
+  static constexpr bool ad_spectrum_from_matrix = true;
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {
     Eigen::Matrix<S, 3, 3> e = Eigen::Matrix<S, 3, 3>::Zero();
@@ -260,6 +297,7 @@ using Heisenberg = MatrixGroup<3, HeisenbergBasis, Scalar>;
 struct SL3Basis {
   static constexpr int dof = 8;
   static constexpr const char* name = "SL3";
+  static constexpr bool ad_spectrum_from_matrix = true;
   template <class S>
   static Eigen::Matrix<S, 3, 3> generator(int k) {
     Eigen::Matrix<S, 3, 3> e = Eigen::Matrix<S, 3, 3>::Zero();
@@ -287,6 +325,7 @@ template <int N>
 struct GLBasis {
   static constexpr int dof = N * N;
   static constexpr const char* name = "GLp";
+  static constexpr bool ad_spectrum_from_matrix = true;
   template <class S>
   static Eigen::Matrix<S, N, N> generator(int k) {
     Eigen::Matrix<S, N, N> e = Eigen::Matrix<S, N, N>::Zero();
