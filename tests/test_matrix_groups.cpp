@@ -177,6 +177,11 @@ TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[ma
   jordan(0, 1) = jordan(1, 2) = 1.0;
   REQUIRE(bireg::math::eigenvalue_spread<double, 3>(jordan) == 0.0);
   REQUIRE(bireg::math::eigenvalue_spread<double, 3>(Matrix3(Matrix3::Zero())) == 0.0);
+  // Eigenvalues +-1e-150 beside a unit entry: (1e-150)^3 underflows.
+  Matrix3 tiny_pair = Matrix3::Zero();
+  tiny_pair(0, 1) = 1.0;
+  tiny_pair(1, 0) = 1e-300;
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(tiny_pair) == Approx(2e-150).epsilon(1e-12));
   // 2 x 2: [1 2; 3 4] has (5 +- sqrt 33)/2; a rotation generator +- i theta.
   REQUIRE(bireg::math::eigenvalue_spread<double, 2>((Eigen::Matrix2d() << 1, 2, 3, 4).finished()) ==
           Approx(std::sqrt(33.0)).epsilon(1e-14));

@@ -76,7 +76,12 @@ Scalar eigenvalue_spread(const Eigen::Matrix<Scalar, N, N>& x) {
     return scale * Scalar(2) * sqrt(abs(a * a + b * c));
   } else {
     const Scalar p = -(y * y).trace() / Scalar(2);
-    const Scalar q = -y.determinant();
+    // det(Y) by cofactors along the first row (Eigen's determinant() lives
+    // in Eigen/LU, which this header does not need).
+    const Scalar determinant = y(0, 0) * (y(1, 1) * y(2, 2) - y(1, 2) * y(2, 1)) -
+                               y(0, 1) * (y(1, 0) * y(2, 2) - y(1, 2) * y(2, 0)) +
+                               y(0, 2) * (y(1, 0) * y(2, 1) - y(1, 1) * y(2, 0));
+    const Scalar q = -determinant;
     const Scalar half_q = q / Scalar(2);
     const Scalar third_p = p / Scalar(3);
     const Scalar d = half_q * half_q + third_p * third_p * third_p;
@@ -91,7 +96,10 @@ Scalar eigenvalue_spread(const Eigen::Matrix<Scalar, N, N>& x) {
     }
     if (!(third_p < 0)) return Scalar(0);  // p = q = 0: a triple eigenvalue
     const Scalar rho = sqrt(-third_p);
-    const Scalar cos_phi = std::clamp(-half_q / (rho * rho * rho), Scalar(-1), Scalar(1));
+    // |q/2| <= rho^3 here; dividing by rho three times keeps a tiny rho
+    // (a pair of eigenvalues +-sqrt(1e-300) beside a unit entry) from
+    // underflowing rho^3 to 0 and the ratio to NaN.
+    const Scalar cos_phi = std::clamp(-half_q / rho / rho / rho, Scalar(-1), Scalar(1));
     const Scalar phi = acos(cos_phi);
     return scale * Scalar(2) * sqrt(Scalar(3)) * rho * sin((phi + pi) / Scalar(3));
   }
