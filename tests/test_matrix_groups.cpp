@@ -177,14 +177,34 @@ TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[ma
   jordan(0, 1) = jordan(1, 2) = 1.0;
   REQUIRE(bireg::math::eigenvalue_spread<double, 3>(jordan) == 0.0);
   REQUIRE(bireg::math::eigenvalue_spread<double, 3>(Matrix3(Matrix3::Zero())) == 0.0);
-  // Eigenvalues +-1e-150 beside a unit entry: (1e-150)^3 underflows.
+  // Eigenvalues +-1e-150 (real) and +-1e-150 i beside a unit entry, and
+  // the cube roots of 1e-200 (spread sqrt(3) 1e-200^(1/3)): their cubes
+  // underflow. Entries near the largest double: their trace overflows.
   Matrix3 tiny_pair = Matrix3::Zero();
   tiny_pair(0, 1) = 1.0;
-  tiny_pair(1, 0) = 1e-300;
-  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(tiny_pair) == Approx(2e-150).epsilon(1e-12));
-  // 2 x 2: [1 2; 3 4] has (5 +- sqrt 33)/2; a rotation generator +- i theta.
-  REQUIRE(bireg::math::eigenvalue_spread<double, 2>((Eigen::Matrix2d() << 1, 2, 3, 4).finished()) ==
-          Approx(std::sqrt(33.0)).epsilon(1e-14));
+  for (double corner : {1e-300, -1e-300}) {
+    tiny_pair(1, 0) = corner;
+    REQUIRE(bireg::math::eigenvalue_spread<double, 3>(tiny_pair) == Approx(2e-150).epsilon(1e-12));
+  }
+  Matrix3 companion = Matrix3::Zero();  // t^3 - 1e-200
+  companion(0, 1) = companion(1, 2) = 1.0;
+  companion(2, 0) = 1e-200;
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(companion) ==
+          Approx(std::sqrt(3.0) * std::cbrt(1e-200)).epsilon(1e-12));
+  const Matrix3 near_max = 1e308 * Matrix3::Identity() + Matrix3::Ones();  // 1e308 + {2, -1, -1}
+  REQUIRE(bireg::math::eigenvalue_spread<double, 3>(near_max) == Approx(3.0).epsilon(1e-12));
+  // float: the same tiny pair at float's range.
+  Eigen::Matrix3f tiny_float = Eigen::Matrix3f::Zero();
+  tiny_float(0, 1) = 1.0f;
+  tiny_float(1, 0) = 1e-30f;
+  REQUIRE(bireg::math::eigenvalue_spread<float, 3>(tiny_float) == Approx(2e-15).epsilon(1e-5));
+  // 2 x 2: [1 2; 3 4] has (5 +- sqrt 33)/2, also at 1e300 and 1e-300; a
+  // rotation generator +- i theta.
+  for (double scale : {1.0, 1e300, 1e-300}) {
+    const Eigen::Matrix2d m = scale * (Eigen::Matrix2d() << 1, 2, 3, 4).finished();
+    REQUIRE(bireg::math::eigenvalue_spread<double, 2>(m) / scale ==
+            Approx(std::sqrt(33.0)).epsilon(1e-14));
+  }
   REQUIRE(bireg::math::eigenvalue_spread<double, 2>(
               (Eigen::Matrix2d() << 0, -0.7, 0.7, 0).finished()) == Approx(1.4).epsilon(1e-14));
   // Not finite in, NaN out (callers test !(radius < limit)).
@@ -217,6 +237,15 @@ TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[ma
   REQUIRE(relative_error(SL::Tangent(SL::ad(sl_x) * v), SL::Tangent(3.2 * v)) <= 1e-12);
   // Heisenberg: X strictly upper triangular, ad_x nilpotent: both 0.
   using H = bireg::Heisenberg<double>;
+  // The three take the closed form, not the eigensolver on ad_x (which
+  // would compile again); none claims ad_spectral_radius itself, which
+  // would turn on the per-residual angle diagnostics.
+  using bireg::capability_detail::ad_spectral_radius_from_matrix;
+  static_assert(bireg::provides_v<GL, ad_spectral_radius_from_matrix>);
+  static_assert(bireg::provides_v<SL, ad_spectral_radius_from_matrix>);
+  static_assert(bireg::provides_v<H, ad_spectral_radius_from_matrix>);
+  static_assert(!bireg::provides_v<GL, bireg::capability_detail::ad_spectral_radius>);
+  static_assert(!bireg::provides_v<bireg::GLp<4, double>, ad_spectral_radius_from_matrix>);
   REQUIRE(bireg::ad_spectral_radius<H>(H::Tangent(0.4, -2.0, 5.0)) == 0.0);
 }
 

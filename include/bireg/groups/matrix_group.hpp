@@ -189,8 +189,9 @@ struct MatrixGroup {
   // gl(N) they are all of them. On sl(N), gl(N) = sl(N) + span(I) with
   // ad_X I = 0, so only a 0 is lost and the largest modulus is kept. On
   // strictly upper-triangular matrices (Heisenberg) X is nilpotent, so
-  // every lambda_i is 0, and ad_X is nilpotent (Engel's theorem): both are
-  // 0. A basis of some other subalgebra leaves the flag unset: there the
+  // every lambda_i is 0, and ad_X = L_X - R_X (left and right
+  // multiplication by X, which commute and are nilpotent) is nilpotent:
+  // both are 0. A basis of some other subalgebra leaves the flag unset: there the
   // largest difference may be missing from g and only bounds the radius.
   template <
       class T = Tangent,
