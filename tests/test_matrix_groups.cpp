@@ -139,11 +139,15 @@ TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[ma
   using Matrix3 = Eigen::Matrix3d;
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> entry(-0.3, 0.3);
-  const auto similar = [&](const Matrix3& d) {
+  const auto near_identity = [&] {  // condition number ~3
     Matrix3 p;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c)
         p(r, c) = (r == c ? 1.0 : 0.0) + entry(rng);
+    return p;
+  };
+  const auto similar = [&](const Matrix3& d) {
+    const Matrix3 p = near_identity();
     return Matrix3(p * d * p.inverse());
   };
   const auto rotation_block = [](double a, double b, double r) {
@@ -219,10 +223,7 @@ TEST_CASE("ad's spectral radius is the spread of the matrix's eigenvalues", "[ma
   // algebra itself: v_i w_j^T (v_i = P e_i, w_j^T = e_j^T P^{-1}) is in
   // sl(3) for i != j and ad_x maps it to (lambda_i - lambda_j) v_i w_j^T.
   const Eigen::Vector3d lambda(0.3, -1.2, 2.0);
-  Matrix3 p;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      p(r, c) = (r == c ? 1.0 : 0.0) + entry(rng);
+  const Matrix3 p = near_identity();
   const Matrix3 p_inverse = p.inverse();
   const Matrix3 x = p * lambda.asDiagonal() * p_inverse;
   using GL = bireg::GLp<3, double>;

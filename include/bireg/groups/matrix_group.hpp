@@ -191,8 +191,9 @@ struct MatrixGroup {
   // strictly upper-triangular matrices (Heisenberg) X is nilpotent, so
   // every lambda_i is 0, and ad_X = L_X - R_X (left and right
   // multiplication by X, which commute and are nilpotent) is nilpotent:
-  // both are 0. A basis of some other subalgebra leaves the flag unset: there the
-  // largest difference may be missing from g and only bounds the radius.
+  // both are 0. A basis of some other subalgebra leaves the flag unset:
+  // there the largest difference may be missing from g and only bounds the
+  // radius.
   template <
       class T = Tangent,
       std::enable_if_t<std::is_same_v<T, Tangent> &&

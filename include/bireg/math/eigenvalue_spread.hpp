@@ -41,9 +41,10 @@
 // the conditioning of the eigenvalues; where two eigenvalues (nearly)
 // coincide, to about sqrt(epsilon) relative (acos near +-1: a double root
 // of the cubic, even where the matrix is diagonalisable and an eigensolver
-// would do better), and near a triple one to about cbrt(epsilon). The spectral radius serves as a
-// threshold (2 pi: the series and the exponential's injectivity) and a reported angle, where that
-// is far below what is resolved. A matrix that is not finite has a NaN spread.
+// would do better), and near a triple one to about cbrt(epsilon). The
+// spectral radius serves as a threshold (2 pi: the series and the
+// exponential's injectivity) and a reported angle, where that is far below
+// what is resolved. A matrix that is not finite has a NaN spread.
 #pragma once
 
 #include <algorithm>
