@@ -23,6 +23,10 @@
 #include <string_view>
 #include <vector>
 
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/stat.h>
+#endif
+
 namespace bireg {
 namespace io {
 
@@ -68,12 +72,23 @@ class ByteSource {
   virtual std::size_t read(char* data, std::size_t size) = 0;
   // Empty unless reading failed.
   virtual std::string error() const = 0;
+  // How many bytes are left to read, as far as the source knows (0:
+  // unknown). Only a hint for reserving memory: reading stops at read()'s 0.
+  virtual std::size_t size_hint() const { return 0; }
 };
 
 // A C stream (a file opened with std::fopen, or stdin).
 class FileSource final : public ByteSource {
  public:
-  explicit FileSource(std::FILE* file) : file_(file) {}
+  explicit FileSource(std::FILE* file) : file_(file) {
+#if defined(__unix__) || defined(__APPLE__)
+    struct stat status;
+    if (file_ && fstat(fileno(file_), &status) == 0 && S_ISREG(status.st_mode)) {
+      const long at = std::ftell(file_);
+      if (at >= 0 && status.st_size > at) size_ = static_cast<std::size_t>(status.st_size - at);
+    }
+#endif
+  }
   std::size_t read(char* data, std::size_t size) override {
     if (!file_ || failed_) return 0;
     errno = 0;
@@ -83,12 +98,19 @@ class FileSource final : public ByteSource {
       error_ = std::string("read error: ") +
                (errno != 0 ? std::strerror(errno) : "the stream reported an error");
     }
+    read_ += got;
     return got;
   }
-  std::string error() const override { return error_; }
+  std::string error() const override {
+    return error_;
+  }
+  std::size_t size_hint() const override {
+    return size_ > read_ ? size_ - read_ : 0;
+  }
 
  private:
   std::FILE* file_;
+  std::size_t size_ = 0, read_ = 0;  // a regular file's bytes from the start, bytes read
   bool failed_ = false;
   std::string error_;
 };
@@ -125,6 +147,7 @@ class MemorySource final : public ByteSource {
     return n;
   }
   std::string error() const override { return {}; }
+  std::size_t size_hint() const override { return text_.size() - at_; }
 
  private:
   std::string_view text_;
@@ -178,6 +201,9 @@ class LineReader {
       if (error_) return false;
     }
   }
+
+  // Bytes not yet handed out, as far as the source knows (a hint).
+  std::size_t remaining_hint() const { return (filled_ - begin_) + source_.size_hint(); }
 
   // Lines handed out so far (the number of the last one).
   std::uint64_t line_number() const { return line_number_; }

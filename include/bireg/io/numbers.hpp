@@ -29,8 +29,19 @@
 namespace bireg {
 namespace io {
 
+namespace detail {
+struct SeparatorTable {
+  bool is[256] = {};
+  constexpr SeparatorTable() {
+    for (const char c : {',', ' ', '\t', '\r', '\n', '\f', '\v'})
+      is[static_cast<unsigned char>(c)] = true;
+  }
+};
+inline constexpr SeparatorTable kSeparators{};
+}  // namespace detail
+
 inline bool is_separator(char c) {
-  return c == ',' || c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+  return detail::kSeparators.is[static_cast<unsigned char>(c)];
 }
 
 // Splits a line at commas and white space (runs of separators count once).
@@ -54,6 +65,46 @@ inline void split_tokens(std::string_view line, std::vector<std::string_view>& t
     i = end;
   }
   if (had_comma) *had_comma = comma;
+}
+
+// The most numbers a line of any format holds (the matrix format of a 4 x 4
+// group: a time and 16 entries); read_numbers leaves longer lines to
+// split_tokens and parse_number.
+inline constexpr std::size_t kMaxNumbersPerLine = 17;
+
+// Splits `line` as split_tokens does and reads each token as parse_number
+// would, in one pass: from_chars finds where a number ends, so the line is
+// scanned once. True when every token is a finite number written the way
+// from_chars reads it whole (at most kMaxNumbersPerLine of them: `numbers`
+// then holds them); false otherwise, and then `tokens` and `had_comma` are
+// split_tokens' and the caller reads the tokens one by one, for the
+// messages parse_number gives.
+inline bool read_numbers(std::string_view line, std::vector<std::string_view>& tokens,
+                         double* numbers, bool& had_comma) {
+  std::string_view found[kMaxNumbersPerLine];
+  std::size_t count = 0;
+  had_comma = false;
+  const char* p = line.data();
+  const char* const end = p + line.size();
+  for (;;) {
+    while (p < end && is_separator(*p)) {
+      had_comma |= *p == ',';
+      ++p;
+    }
+    if (p == end) break;
+    double value = 0;
+    const auto result = std::from_chars(p, end, value);
+    if (result.ec != std::errc() || (result.ptr != end && !is_separator(*result.ptr)) ||
+        !std::isfinite(value) || count == kMaxNumbersPerLine) {
+      split_tokens(line, tokens, &had_comma);
+      return false;
+    }
+    numbers[count] = value;
+    found[count++] = std::string_view(p, static_cast<std::size_t>(result.ptr - p));
+    p = result.ptr;
+  }
+  tokens.assign(found, found + count);
+  return true;
 }
 
 // A finite double, or the reason the token is not one: "not a number: '...'",
@@ -104,8 +155,79 @@ namespace detail {
 // The exact fixed-point value of a plain decimal token, scaled by 10^-shift
 // (shift 9: nanoseconds to seconds). False when the token is not a plain
 // decimal or needs more than 18 integer or 18 fractional digits.
+inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
+                                  std::uint64_t& fraction);
+
+// The floor form of +-(w + f / 1e18).
+inline void set_floor_form(bool negative, std::uint64_t w, std::uint64_t f, std::int64_t& whole,
+                           std::uint64_t& fraction) {
+  if (!negative || (w == 0 && f == 0)) {
+    whole = static_cast<std::int64_t>(w);
+    fraction = f;
+  } else if (f == 0) {
+    whole = -static_cast<std::int64_t>(w);
+    fraction = 0;
+  } else {
+    whole = -static_cast<std::int64_t>(w) - 1;
+    fraction = kFractionScale - f;
+  }
+}
+
+// exact_decimal's common case in one pass: a sign, at most 19 digits in
+// all and an optional point, no exponent. The digits as one integer v
+// scaled by 10^-(fraction digits + shift), split at the point.
 inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
                           std::uint64_t& fraction) {
+  static constexpr std::uint64_t kPow10[19] = {1ULL,
+                                               10ULL,
+                                               100ULL,
+                                               1000ULL,
+                                               10000ULL,
+                                               100000ULL,
+                                               1000000ULL,
+                                               10000000ULL,
+                                               100000000ULL,
+                                               1000000000ULL,
+                                               10000000000ULL,
+                                               100000000000ULL,
+                                               1000000000000ULL,
+                                               10000000000000ULL,
+                                               100000000000000ULL,
+                                               1000000000000000ULL,
+                                               10000000000000000ULL,
+                                               100000000000000000ULL,
+                                               1000000000000000000ULL};
+  std::size_t i = 0;
+  const bool negative = !s.empty() && s[0] == '-';
+  if (!s.empty() && (s[0] == '-' || s[0] == '+')) ++i;
+  std::uint64_t v = 0;
+  int digits = 0, fraction_digits = -1;  // -1: no point yet
+  for (; i < s.size(); ++i) {
+    const char c = s[i];
+    if (c >= '0' && c <= '9') {
+      v = v * 10 + static_cast<std::uint64_t>(c - '0');
+      ++digits;
+      if (fraction_digits >= 0) ++fraction_digits;
+    } else if (c == '.' && fraction_digits < 0) {
+      fraction_digits = 0;
+    } else {
+      break;
+    }
+  }
+  const int scale = (fraction_digits < 0 ? 0 : fraction_digits) + shift;
+  // 19 digits fit in 64 bits; the whole seconds must stay below 1e18.
+  if (i != s.size() || digits == 0 || digits > 19 || scale > 18 ||
+      v / kPow10[scale] >= kFractionScale) {
+    return exact_decimal_general(s, shift, whole, fraction);
+  }
+  set_floor_form(negative, v / kPow10[scale], (v % kPow10[scale]) * kPow10[18 - scale], whole,
+                 fraction);
+  return true;
+}
+
+// Any plain decimal, exponent included.
+inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
+                                  std::uint64_t& fraction) {
   static constexpr std::uint64_t kPow10[19] = {1ULL,
                                                10ULL,
                                                100ULL,
@@ -172,16 +294,7 @@ inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
   }
   if (!any_digit) return false;
   // |value| < 1e18: w fits in int64; floor form for negative values.
-  if (!negative || (w == 0 && f == 0)) {
-    whole = static_cast<std::int64_t>(w);
-    fraction = f;
-  } else if (f == 0) {
-    whole = -static_cast<std::int64_t>(w);
-    fraction = 0;
-  } else {
-    whole = -static_cast<std::int64_t>(w) - 1;
-    fraction = kFractionScale - f;
-  }
+  set_floor_form(negative, w, f, whole, fraction);
   return true;
 }
 
@@ -189,14 +302,20 @@ inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
 
 // Reads a timestamp token in `unit`: a finite number (parse_number's rules
 // and messages), kept as text and, when possible, exactly.
-inline std::optional<std::string> parse_timestamp(std::string_view token, TimeUnit unit,
-                                                  Timestamp& out) {
-  double value = 0;
-  if (auto problem = parse_number(token, value)) return problem;
+// The timestamp of a token that parse_number has read as `value`.
+inline void timestamp_of_number(std::string_view token, double value, TimeUnit unit,
+                                Timestamp& out) {
   const int shift = unit == TimeUnit::nanoseconds ? 9 : 0;
   out.text.assign(token.data(), token.size());
   out.seconds = unit == TimeUnit::nanoseconds ? value * 1e-9 : value;
   out.exact = detail::exact_decimal(token, shift, out.whole, out.fraction);
+}
+
+inline std::optional<std::string> parse_timestamp(std::string_view token, TimeUnit unit,
+                                                  Timestamp& out) {
+  double value = 0;
+  if (auto problem = parse_number(token, value)) return problem;
+  timestamp_of_number(token, value, unit, out);
   return std::nullopt;
 }
 
