@@ -26,11 +26,13 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/io/writers.hpp"
 #include "bireg/regression.hpp"
+#include "bireg/spline_regression.hpp"
 #include "bireg/statistics/inference/confidence.hpp"
 #include "bireg/statistics/inference/covariance.hpp"
 #include "bireg/statistics/inference/explained_variance.hpp"
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
+#include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "bireg/version.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -246,27 +248,16 @@ TEST_CASE("bireg_fit --help lists every option with its default, and the exit co
     REQUIRE(run.out.rfind("usage: bireg_fit", 0) == 0);
     // Every option the tool takes, on one line of its own that says what it
     // does and its default (or that it is required).
-    const std::vector<std::string> options = {"--group",
-                                              "--format",
-                                              "--times",
-                                              "--project",
-                                              "--method",
-                                              "--order",
-                                              "--solver",
-                                              "--step",
-                                              "--tol",
-                                              "--max-iter",
-                                              "--loss",
-                                              "--loss-scale",
-                                              "--confidence",
-                                              "--permutations",
-                                              "--seed",
-                                              "--output-band",
-                                              "--output-trajectory",
-                                              "--output-format",
-                                              "--threads",
-                                              "--help",
-                                              "--version"};
+    const std::vector<std::string> options = {
+        "--group",         "--format",       "--times",
+        "--project",       "--method",       "--order",
+        "--solver",        "--step",         "--tol",
+        "--max-iter",      "--loss",         "--loss-scale",
+        "--confidence",    "--permutations", "--seed",
+        "--output-band",   "--model",        "--degree",
+        "--knot-spacing",  "--cv-table",     "--output-trajectory",
+        "--output-format", "--threads",      "--help",
+        "--version"};
     std::map<std::string, std::string> line_of;
     std::istringstream lines(run.out);
     for (std::string line; std::getline(lines, line);) {
@@ -356,6 +347,113 @@ TEST_CASE("bireg_fit --output-trajectory writes the fitted geodesic in the input
   for (std::size_t i = 0; i < fitted.observations.size(); ++i) {
     REQUIRE(bireg_test::relative_error(fitted.observations[i], geodesic(input.covariates[i])) <=
             1e-14);
+  }
+}
+
+TEST_CASE("bireg_fit --model spline prints the library's spline: control points and knots",
+          "[tool][spline]") {
+  using G = bireg::SE3<double>;
+  // A curved SE(3) path (not a geodesic) over 4 s at 50 Hz with noise of
+  // 0.01 per coordinate, in the matrix format.
+  std::mt19937 rng(21);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<G::Element> poses;
+  std::vector<bireg::io::Timestamp> times;
+  for (int i = 0; i < 200; ++i) {
+    const double t = 0.02 * i;
+    G::Tangent x;
+    x << std::sin(t), 0.5 * t, 0.2 * t * t, 0.3 * t, 0.4 * std::sin(1.5 * t), 0.1 * t * t;
+    G::Tangent e;
+    for (int k = 0; k < 6; ++k)
+      e[k] = noise(rng);
+    poses.push_back(G::compose(G::exp(x), G::exp(e)));
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f", 1700000000.0 + t);
+    times.emplace_back();
+    REQUIRE_FALSE(bireg::io::parse_timestamp(text, bireg::io::TimeUnit::seconds, times.back()));
+  }
+  const fs::path input = work_dir() / ("spline_" + std::to_string(getpid()) + ".csv");
+  {
+    std::ofstream(input) << bireg::io::format_trajectory<G>(
+        bireg::io::Format::matrix, bireg::io::Format::matrix, times, poses);
+  }
+  const auto trajectory = read_file<G>(input.string(), bireg::io::Format::matrix);
+  const fs::path fitted = work_dir() / ("spline_fitted_" + std::to_string(getpid()) + ".csv");
+
+  const Run run = run_tool("--group SE3 --model spline --knot-spacing 0.5 --output-trajectory \"" +
+                           fitted.string() + "\" \"" + input.string() + "\"");
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.err.empty());
+  REQUIRE_FALSE(json_has_non_finite(run.out));
+  REQUIRE(json_string(run.out, "model") == "spline");
+  REQUIRE(json_string(run.out, "status") == "converged");
+  REQUIRE(json_string(run.out, "knot_spacing_source") == "given");
+
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = 0.5;
+  const auto library =
+      bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
+  REQUIRE(library.ok());
+  const bireg::Spline<G>& spline = *library.spline;
+  REQUIRE(json_numbers(run.out, "degree").at(0) == 3);
+  REQUIRE(json_numbers(run.out, "knot_spacing").at(0) == spline.knot_spacing());
+  REQUIRE(json_numbers(run.out, "iterations").at(0) == library.iterations);
+  // Knots in seconds after t_min: the first at 0, one per segment boundary.
+  const std::vector<double> knots = json_numbers(run.out, "knots");
+  REQUIRE(knots.size() == spline.segments() + 1);
+  REQUIRE(knots.front() == spline.t_min());
+  REQUIRE(knots.back() == Approx(spline.t_max()).margin(1e-12));
+  // The same computation in two binaries (see check_against_library): 1e-12.
+  const std::vector<double> points = json_numbers(run.out, "control_points");
+  REQUIRE(points.size() == 16 * spline.control_points().size());
+  for (std::size_t j = 0; j < spline.control_points().size(); ++j) {
+    const std::vector<double> entries(points.begin() + 16 * j, points.begin() + 16 * (j + 1));
+    REQUIRE(bireg_test::relative_error(element_of<G>(entries), spline.control_points()[j]) <=
+            1e-12);
+  }
+  // --output-trajectory: the spline at every input time.
+  const auto written = read_file<G>(fitted.string(), bireg::io::Format::matrix);
+  REQUIRE(written.covariates == trajectory.covariates);
+  for (std::size_t i = 0; i < written.observations.size(); ++i) {
+    REQUIRE(bireg_test::relative_error(written.observations[i], spline(trajectory.covariates[i])) <=
+            1e-12);
+  }
+
+  // auto: the cross-validation's choice, said on stderr and kept in the JSON.
+  const Run automatic = run_tool("--group SE3 --model spline \"" + input.string() + "\"");
+  CAPTURE(automatic.err);
+  REQUIRE(automatic.exit_code == 0);
+  REQUIRE(automatic.err.find("bireg_fit: knot spacing auto: ") == 0);
+  REQUIRE(json_string(automatic.out, "knot_spacing_source") == "auto");
+  const auto grid = bireg::auto_knot_spacing_grid(trajectory.covariates);
+  const auto selection =
+      bireg::select_knot_spacing<G>(trajectory.observations, trajectory.covariates, {}, grid);
+  REQUIRE(selection.ok());
+  REQUIRE(json_numbers(automatic.out, "chosen").at(0) == selection.knot_spacing);
+  REQUIRE(automatic.out.find("\"candidates\": [") != std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(automatic.out));
+
+  // Each model's options are refused with the other, and the groups without
+  // a spline are named.
+  const std::string file = " \"" + input.string() + "\"";
+  const std::vector<std::pair<std::string, std::string>> refusals = {
+      {"--group SE3 --model spline --loss huber", "--loss applies to --model geodesic only"},
+      {"--group SE3 --model spline --confidence 0.9",
+       "--confidence applies to --model geodesic only"},
+      {"--group SE3 --degree 2", "--degree applies to --model spline only"},
+      {"--group SE3 --knot-spacing 1", "--knot-spacing applies to --model spline only"},
+      {"--group SE3 --model spline --knot-spacing 0", "--knot-spacing needs a positive number"},
+      {"--group SE3 --model spline --degree 4", "--degree needs 1, 2 or 3"},
+      {"--group SE3 --model cubic", "unknown model 'cubic' (geodesic or spline)"},
+      {"--group Sim3 --model spline", "--model spline fits SO2, SO3, SE2 and SE3, not Sim3"},
+      {"--group auto --model spline", "--group auto chooses among geodesic motion models"}};
+  for (const auto& [args, message] : refusals) {
+    const Run refused = run_tool(args + file);
+    CAPTURE(args, refused.err);
+    REQUIRE(refused.exit_code == 2);
+    REQUIRE(refused.out.empty());
+    REQUIRE(refused.err.find("bireg_fit: " + message) == 0);
   }
 }
 

@@ -9,7 +9,22 @@
 //             [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]
 //             [--threads N] FILE|-
+//   bireg_fit --group SO2|SO3|SE2|SE3 --model spline [--degree 1|2|3]
+//             [--knot-spacing S|auto] [--cv-table FILE] [input and output options]
+//             [--tol X] [--max-iter K] [--threads N] FILE|-
 //   bireg_fit --help | --version
+//
+// --model spline fits one bi-invariant cumulative B-spline of --degree
+// (default 3) through the whole trajectory instead of one geodesic
+// (bireg/spline_regression.hpp), with uniform knots at most --knot-spacing
+// seconds apart, auto (the default) choosing the spacing by
+// cross-validation as bireg_smooth --method spline does (--cv-table FILE
+// writes that curve). The JSON then holds the curve: "degree",
+// "knot_spacing", "knots" (seconds after t_min), "control_points" (one
+// matrix each), the status and diagnostics and, for auto, a
+// "knot_selection" object with every spacing tried. --output-trajectory
+// writes the spline at every input time. The geodesic's solver, series,
+// robust and statistics options are refused with it.
 //
 // --help prints the usage, every option with its default and meaning, and
 // the exit codes on stdout; --version prints "bireg_fit <version>"
@@ -105,6 +120,9 @@ constexpr const char* kUsage =
     "                 [--confidence LEVEL] [--permutations B [--seed S]] [--output-band FILE]\n"
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
     "                 [--threads N] FILE|-\n"
+    "       bireg_fit --group SO2|SO3|SE2|SE3 --model spline [--degree 1|2|3]\n"
+    "                 [--knot-spacing S|auto] [--cv-table FILE] [--tol X] [--max-iter K] ... "
+    "FILE|-\n"
     "       bireg_fit --help | --version\n";
 
 // --help: the usage, every option on one line with its meaning and default
@@ -115,8 +133,9 @@ std::string help_text() {
       bireg::io::format_double(bireg::RegressionOptions<double>().tolerance);
   std::string text = kUsage;
   text +=
-      "\nFits a bi-invariant geodesic to the trajectory in FILE (- for standard input) and\n"
-      "prints one JSON object on stdout (README.md, \"bireg_fit\").\n"
+      "\nFits a bi-invariant geodesic (or, with --model spline, a spline) to the trajectory in\n"
+      "FILE (- for standard input) and prints one JSON object on stdout (README.md,\n"
+      "\"bireg_fit\").\n"
       "\nOptions (each at most once):\n"
       "  --group G                 SO2 SO3 SE2 SE3 Sim3 SL3 GLp3, or auto: model of SE3/Sim3 poses "
       "(required)\n"
@@ -155,6 +174,12 @@ std::string help_text() {
       "  --seed S                  the trend test's random seed, with --permutations (default 0)\n"
       "  --output-band FILE        CSV of fitted poses and confidence half-widths; SO3, SE3 "
       "(default none)\n"
+      "  --model M                 geodesic, or spline: one cumulative B-spline; SO2 SO3 SE2 SE3 "
+      "(default geodesic)\n"
+      "  --degree K                the spline's degree, 1, 2 or 3 (default 3)\n"
+      "  --knot-spacing S|auto     the spline's largest knot spacing in seconds, or auto: "
+      "cross-validated (default auto)\n"
+      "  --cv-table FILE           CSV of the knot spacings tried by auto (default none)\n"
       "  --output-trajectory FILE  write the fitted geodesic at every input time (default none)\n"
       "  --output-format F         the format of --output-trajectory (default the input's)\n"
       "  --threads N               threads; the output does not depend on N (default every core: " +
@@ -267,6 +292,7 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
       if (!parse_count(*v, command.max_iterations) || command.max_iterations < 1) {
         return "--max-iter needs a positive integer";
       }
+      command.max_iterations_given = true;
     } else if (arg == "--loss") {
       for (bireg::Loss loss : {bireg::Loss::huber, bireg::Loss::cauchy, bireg::Loss::tukey}) {
         if (*v == bireg::to_string(loss)) command.loss = loss;
@@ -298,6 +324,25 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
       command.output_band = *v;
     } else if (arg == "--output-trajectory") {
       command.output_trajectory = *v;
+    } else if (arg == "--model") {
+      if (*v != "geodesic" && *v != "spline") {
+        return "unknown model '" + *v + "' (geodesic or spline)";
+      }
+      command.spline = *v == "spline";
+    } else if (arg == "--degree") {
+      if (*v != "1" && *v != "2" && *v != "3") return "--degree needs 1, 2 or 3";
+      command.degree = (*v)[0] - '0';
+    } else if (arg == "--knot-spacing") {
+      double h = 0;
+      if (*v == "auto") {
+        command.knot_spacing.reset();
+      } else if (!parse_number(*v, h) || !(h > 0)) {
+        return "--knot-spacing needs a positive number or auto";
+      } else {
+        command.knot_spacing = h;
+      }
+    } else if (arg == "--cv-table") {
+      command.cv_table = *v;
     } else {
       return "unknown option " + arg;
     }
@@ -314,6 +359,25 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
   }
   if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
   if (command.seed && command.permutations == 0) return "--seed goes with --permutations B";
+  // Each model's own options, refused with the other.
+  for (const char* option : {"--degree", "--knot-spacing", "--cv-table"}) {
+    if (!command.spline && given.count(option)) {
+      return std::string(option) + " applies to --model spline only";
+    }
+  }
+  for (const char* option : {"--method", "--order", "--solver", "--step", "--loss", "--loss-scale",
+                             "--confidence", "--permutations", "--seed", "--output-band"}) {
+    if (command.spline && given.count(option)) {
+      return std::string(option) + " applies to --model geodesic only";
+    }
+  }
+  if (command.spline && command.group == "auto") {
+    return "--group auto chooses among geodesic motion models: give the group with --model "
+           "spline";
+  }
+  if (command.cv_table.size() && command.knot_spacing) {
+    return "--cv-table goes with --knot-spacing auto";
+  }
   return std::nullopt;
 }
 
@@ -335,6 +399,7 @@ int bireg_cli::fit_main(int argc, char** argv) {
     }
     return 0;
   }
+  if (command.spline) return bireg_cli::run_spline(command);
   if (command.group == "auto") {
     const bool fit_options = command.loss || command.confidence || command.permutations > 0 ||
                              !command.output_band.empty();

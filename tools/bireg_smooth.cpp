@@ -96,17 +96,20 @@
 #include "bireg/spline_regression.hpp"
 #include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
-#include "bireg/statistics/smoothing/spline_knots.hpp"
 #include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
+#include "spline_fit.hpp"
 
 namespace {
 
+using bireg_cli::fit_spline;
 using bireg_cli::kExitInvalid;
 using bireg_cli::kExitNotConverged;
 using bireg_cli::kExitWriteError;
 using bireg_cli::parse_number;
+using bireg_cli::SplineFit;
+using bireg_cli::SplineRequest;
 
 constexpr const char* kUsage =
     "usage: bireg_smooth --group SO2|SO3|SE2|SE3 [--format matrix|tum|euroc|kitti]\n"
@@ -457,24 +460,6 @@ std::optional<int> local_estimates(const Command& command, const std::string& na
   return std::nullopt;
 }
 
-// The cross-validation curve of --knot-spacing auto, one row per spacing:
-// its criterion (empty where refused), failed fits, and why it was refused.
-template <class Scalar>
-std::optional<std::string> write_knot_table(const std::string& path,
-                                            const bireg::KnotSpacingSelection<Scalar>& selection) {
-  std::string text = "knot_spacing,criterion,failures,refused\n";
-  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
-    bireg::io::append_double(text, selection.grid[k]);
-    text += ',';
-    if (std::isfinite(selection.criterion[k])) {
-      bireg::io::append_double(text, selection.criterion[k]);
-    }
-    text += ',' + std::to_string(selection.failures[k]) + ',' +
-            bireg_cli::csv_field(selection.refusals[k]) + '\n';
-  }
-  return bireg_cli::write_text_file(path, text);
-}
-
 // --method spline: one fit, every query's pose and velocity read off it (as
 // LocalEstimate rows, so that the output is written as the local method's).
 // Returns an exit code when it cannot go on.
@@ -483,56 +468,14 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
                                     const bireg::io::Trajectory<G>& trajectory,
                                     const std::vector<double>& queries,
                                     std::vector<bireg::LocalEstimate<G>>& estimates) {
-  namespace io = bireg::io;
-  bireg::SplineOptions<double> options;
-  options.degree = command.degree;
-  options.threads = command.threads;
-  if (command.knot_spacing) {
-    options.knot_spacing = *command.knot_spacing;
-  } else {
-    const std::vector<double> grid = bireg::auto_knot_spacing_grid(trajectory.covariates);
-    const bireg::KnotSpacingSelection<double> selection = bireg::select_knot_spacing<G>(
-        trajectory.observations, trajectory.covariates, options, grid);
-    if (!command.cv_table.empty()) {
-      if (auto error = write_knot_table(command.cv_table, selection)) {
-        std::fprintf(stderr, "bireg_smooth: %s\n", error->c_str());
-        return kExitWriteError;
-      }
-    }
-    if (!selection.ok()) {
-      return fail(name + ": knot spacing auto: " + selection.message + ": give --knot-spacing S");
-    }
-    options.knot_spacing = selection.knot_spacing;
-    std::fprintf(stderr,
-                 "bireg_smooth: knot spacing auto: %s s (cross-validation over %zu values from "
-                 "%s to %s s)\n",
-                 io::json_number(selection.knot_spacing).c_str(), grid.size(),
-                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
-    if (!selection.message.empty()) {
-      std::fprintf(stderr, "bireg_smooth: warning: knot spacing auto: %s\n",
-                   selection.message.c_str());
-    }
-  }
-  const bireg::SplineResult<G> fit =
-      bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
-  if (fit.status == bireg::Status::invalid_input) return fail(name + ": " + fit.message);
-  // Near the log's cut locus (SplineResult::beyond_domain): say where.
-  if (fit.ok() && fit.largest_residual_angle > bireg::kBeyondDomainAngle<double>) {
-    const auto observation = static_cast<std::size_t>(fit.largest_residual_observation);
-    std::fprintf(stderr,
-                 "bireg_smooth: %s: warning: this observation lies %.3g rad from the fitted "
-                 "spline, beyond 3 pi/4: a gross outlier, or motion too fast for the knots\n",
-                 bireg_cli::where(name, trajectory.lines[observation]).c_str(),
-                 fit.largest_residual_angle);
-  }
-  if (fit.ok() && fit.largest_increment_angle > bireg::kBeyondDomainAngle<double>) {
-    std::fprintf(stderr,
-                 "bireg_smooth: %s: warning: the spline turns by %.3g rad between control "
-                 "points %td and %td, beyond 3 pi/4 (a half turn is where it jumps): use a "
-                 "narrower --knot-spacing\n",
-                 name.c_str(), fit.largest_increment_angle, fit.largest_increment - 1,
-                 fit.largest_increment);
-  }
+  SplineRequest request;
+  request.degree = command.degree;
+  request.knot_spacing = command.knot_spacing;
+  request.threads = command.threads;
+  request.cv_table = command.cv_table;
+  SplineFit<G> spline_fit;
+  if (auto code = fit_spline<G>("bireg_smooth", request, name, trajectory, spline_fit)) return code;
+  const bireg::SplineResult<G>& fit = spline_fit.fit;
   // The standard errors go to the velocity CSV only: no covariance (up to
   // O((Md)^2) memory and time) unless it is asked for.
   std::optional<bireg::SplineCovariance<G>> covariance;

@@ -1,0 +1,116 @@
+// bireg_cli::fit_spline (spline_fit.hpp), instantiated for the groups the
+// tools fit splines in.
+#include "spline_fit.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "bireg/groups/se2.hpp"
+#include "bireg/groups/se3.hpp"
+#include "bireg/groups/so2.hpp"
+#include "bireg/groups/so3.hpp"
+#include "bireg/io/writers.hpp"
+#include "cli_common.hpp"
+
+namespace bireg_cli {
+namespace {
+
+// The cross-validation curve of --knot-spacing auto, one row per spacing:
+// its criterion (empty where refused), failed fits, and why it was refused.
+std::optional<std::string> write_knot_table(const std::string& path,
+                                            const bireg::KnotSpacingSelection<double>& selection) {
+  std::string text = "knot_spacing,criterion,failures,refused\n";
+  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
+    bireg::io::append_double(text, selection.grid[k]);
+    text += ',';
+    if (std::isfinite(selection.criterion[k])) {
+      bireg::io::append_double(text, selection.criterion[k]);
+    }
+    text += ',' + std::to_string(selection.failures[k]) + ',' +
+            bireg_cli::csv_field(selection.refusals[k]) + '\n';
+  }
+  return bireg_cli::write_text_file(path, text);
+}
+
+int fail(const char* tool, const std::string& message) {
+  std::fprintf(stderr, "%s: %s\n", tool, message.c_str());
+  return kExitInvalid;
+}
+
+}  // namespace
+
+template <class G>
+std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
+                              const std::string& name, const bireg::io::Trajectory<G>& trajectory,
+                              SplineFit<G>& out) {
+  namespace io = bireg::io;
+  bireg::SplineOptions<double> options;
+  options.degree = request.degree;
+  options.threads = request.threads;
+  if (request.tolerance) options.tolerance = *request.tolerance;
+  if (request.max_iterations) options.max_iterations = *request.max_iterations;
+  out.selection.reset();
+  if (request.knot_spacing) {
+    options.knot_spacing = *request.knot_spacing;
+  } else {
+    const std::vector<double> grid = bireg::auto_knot_spacing_grid(trajectory.covariates);
+    out.selection = bireg::select_knot_spacing<G>(trajectory.observations, trajectory.covariates,
+                                                  options, grid);
+    const bireg::KnotSpacingSelection<double>& selection = *out.selection;
+    if (!request.cv_table.empty()) {
+      if (auto error = write_knot_table(request.cv_table, selection)) {
+        std::fprintf(stderr, "%s: %s\n", tool, error->c_str());
+        return kExitWriteError;
+      }
+    }
+    if (!selection.ok()) {
+      return fail(tool,
+                  name + ": knot spacing auto: " + selection.message + ": give --knot-spacing S");
+    }
+    options.knot_spacing = selection.knot_spacing;
+    std::fprintf(stderr,
+                 "%s: knot spacing auto: %s s (cross-validation over %zu values from %s to %s s)\n",
+                 tool, io::json_number(selection.knot_spacing).c_str(), grid.size(),
+                 io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
+    if (!selection.message.empty()) {
+      std::fprintf(stderr, "%s: warning: knot spacing auto: %s\n", tool, selection.message.c_str());
+    }
+  }
+  out.fit = bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
+  const bireg::SplineResult<G>& fit = out.fit;
+  if (fit.status == bireg::Status::invalid_input) return fail(tool, name + ": " + fit.message);
+  // Near the log's cut locus (SplineResult::beyond_domain): say where.
+  if (fit.ok() && fit.largest_residual_angle > bireg::kBeyondDomainAngle<double>) {
+    const auto observation = static_cast<std::size_t>(fit.largest_residual_observation);
+    std::fprintf(stderr,
+                 "%s: %s: warning: this observation lies %.3g rad from the fitted spline, "
+                 "beyond 3 pi/4: a gross outlier, or motion too fast for the knots\n",
+                 tool, bireg_cli::where(name, trajectory.lines[observation]).c_str(),
+                 fit.largest_residual_angle);
+  }
+  if (fit.ok() && fit.largest_increment_angle > bireg::kBeyondDomainAngle<double>) {
+    std::fprintf(stderr,
+                 "%s: %s: warning: the spline turns by %.3g rad between control points %td and "
+                 "%td, beyond 3 pi/4 (a half turn is where it jumps): use a narrower "
+                 "--knot-spacing\n",
+                 tool, name.c_str(), fit.largest_increment_angle, fit.largest_increment - 1,
+                 fit.largest_increment);
+  }
+  return std::nullopt;
+}
+
+template std::optional<int> fit_spline(const char*, const SplineRequest&, const std::string&,
+                                       const bireg::io::Trajectory<bireg::SO2<double>>&,
+                                       SplineFit<bireg::SO2<double>>&);
+template std::optional<int> fit_spline(const char*, const SplineRequest&, const std::string&,
+                                       const bireg::io::Trajectory<bireg::SO3<double>>&,
+                                       SplineFit<bireg::SO3<double>>&);
+template std::optional<int> fit_spline(const char*, const SplineRequest&, const std::string&,
+                                       const bireg::io::Trajectory<bireg::SE2<double>>&,
+                                       SplineFit<bireg::SE2<double>>&);
+template std::optional<int> fit_spline(const char*, const SplineRequest&, const std::string&,
+                                       const bireg::io::Trajectory<bireg::SE3<double>>&,
+                                       SplineFit<bireg::SE3<double>>&);
+
+}  // namespace bireg_cli
