@@ -446,7 +446,12 @@ TEST_CASE("bireg_fit --model spline prints the library's spline: control points 
       {"--group SE3 --model spline --knot-spacing 0", "--knot-spacing needs a positive number"},
       {"--group SE3 --model spline --degree 4", "--degree needs 1, 2 or 3"},
       {"--group SE3 --model cubic", "unknown model 'cubic' (geodesic or spline)"},
+      {"--group SE3 --model spline --method series", "--method applies to --model geodesic only"},
+      {"--group SE3 --model spline --seed 1", "--seed applies to --model geodesic only"},
+      {"--group SE3 --model spline --knot-spacing 1 --cv-table t.csv",
+       "--cv-table goes with --knot-spacing auto"},
       {"--group Sim3 --model spline", "--model spline fits SO2, SO3, SE2 and SE3, not Sim3"},
+      {"--group Foo --model spline", "unknown group 'Foo' (--model spline fits SO2, SO3, SE2 or"},
       {"--group auto --model spline", "--group auto chooses among geodesic motion models"}};
   for (const auto& [args, message] : refusals) {
     const Run refused = run_tool(args + file);
@@ -455,6 +460,44 @@ TEST_CASE("bireg_fit --model spline prints the library's spline: control points 
     REQUIRE(refused.out.empty());
     REQUIRE(refused.err.find("bireg_fit: " + message) == 0);
   }
+
+  // --max-iter reaches the spline: one step is not enough, the JSON is
+  // still printed with that status, and exit code 3 says why.
+  const Run stopped = run_tool("--group SE3 --model spline --knot-spacing 0.5 --max-iter 1" + file);
+  CAPTURE(stopped.err);
+  REQUIRE(stopped.exit_code == 3);
+  REQUIRE(json_string(stopped.out, "status") == "max_iterations");
+  REQUIRE(json_numbers(stopped.out, "iterations").at(0) == 1);
+  REQUIRE(stopped.err.find("the iteration limit (--max-iter) was reached first; exit code 3") !=
+          std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(stopped.out));
+
+  // Too few observations to cross-validate: refused, naming the remedy, and
+  // the --cv-table file says for every spacing why it was not tried.
+  std::string few;
+  for (int i = 0; i < 5; ++i) {
+    few += std::to_string(i) + " 0." + std::to_string(i) + " 0 0 0 0 0 1\n";
+  }
+  const fs::path table = work_dir() / ("spline_cv_" + std::to_string(getpid()) + ".csv");
+  const fs::path few_file = work_dir() / ("spline_few_" + std::to_string(getpid()) + ".tum");
+  std::ofstream(few_file) << few;
+  const Run too_few = run_tool("--group SE3 --model spline --cv-table \"" + table.string() +
+                               "\" \"" + few_file.string() + "\"");
+  CAPTURE(too_few.err);
+  REQUIRE(too_few.exit_code == 2);
+  REQUIRE(too_few.err.find("knot spacing auto: knot spacing selection needs") != std::string::npos);
+  REQUIRE(too_few.err.find("give --knot-spacing S") != std::string::npos);
+  const std::string table_text = slurp(table);
+  REQUIRE(table_text.rfind("knot_spacing,criterion,failures,refused\n", 0) == 0);
+  std::istringstream rows(table_text);
+  std::string row;
+  std::getline(rows, row);  // the header
+  int refused_rows = 0;
+  for (; std::getline(rows, row); ++refused_rows) {
+    CAPTURE(row);
+    REQUIRE(row.find(",,0,\"not tried: knot spacing selection needs") != std::string::npos);
+  }
+  REQUIRE(refused_rows > 0);
 }
 
 // ---- the io/ layer through the tool: formats, timestamps, hostile input ----

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -342,21 +343,26 @@ TEST_CASE("exact decimals: the one-pass reader agrees with the general one", "[i
 }
 
 TEST_CASE("the reader reserves for the lines left once, from any source", "[io]") {
-  // 1,100 lines of one length: without the estimate the vectors would
-  // double to 2,048; with it they hold 1,100 to 1,100 * 1.125 + 1.
+  // 5,000 lines of one length (245 KB, more than the reader's 64 KiB
+  // block, so the source's size hint decides): with the estimate the
+  // vectors hold 5,000 to 5,000 * 1.125 + 2; from the buffered block alone
+  // (no hint) they would double past it, to about 6,000.
+  constexpr int kLines = 5000;
   std::string text;
-  for (int i = 0; i < 1100; ++i) {
+  for (int i = 0; i < kLines; ++i) {
     char line[96];
     std::snprintf(line, sizeof line, "%d.%06d 0.%06d 1.5 -2.%06d 0 0 0 1\n", 1700000000 + i,
                   (37 * i) % 1000000, (91 * i) % 1000000, (53 * i) % 1000000);
     text += line;
   }
+  const std::size_t most = kLines + kLines / 8 + 2;
   const auto memory = read_ok<SE3>(text);
-  REQUIRE(memory.observations.size() == 1100);
-  REQUIRE(memory.observations.capacity() <= 1100 + 1100 / 8 + 2);
+  REQUIRE(memory.observations.size() == kLines);
+  REQUIRE(memory.observations.capacity() <= most);
   REQUIRE(memory.timestamps.capacity() == memory.observations.capacity());
 
-  // A regular file (fstat's size) and a stream (no hint) read the same.
+  // A regular file (fstat's size) reads the same with the same reservation;
+  // a stream (no hint) reads the same.
   std::FILE* file = std::tmpfile();
   REQUIRE(file != nullptr);
   REQUIRE(std::fwrite(text.data(), 1, text.size(), file) == text.size());
@@ -366,21 +372,28 @@ TEST_CASE("the reader reserves for the lines left once, from any source", "[io]"
   bireg::io::Trajectory<SE3> from_file, from_stream;
   REQUIRE_FALSE(bireg::io::read_trajectory<SE3>(file_source, bireg::io::ReadOptions{}, from_file));
   std::fclose(file);
-  REQUIRE(from_file.observations.capacity() <= 1100 + 1100 / 8 + 2);
+  REQUIRE(from_file.observations.capacity() <= most);
   std::istringstream stream(text);
   REQUIRE_FALSE(bireg::io::read_trajectory<SE3>(stream, bireg::io::ReadOptions{}, from_stream));
+  REQUIRE(from_stream.observations.capacity() > most);
   REQUIRE(from_file.observations == memory.observations);
   REQUIRE(from_stream.observations == memory.observations);
   REQUIRE(from_file.covariates == memory.covariates);
   REQUIRE(from_stream.covariates == memory.covariates);
 
-  // A first line much shorter than the rest: the estimate is too small and
-  // the vectors grow as before, with the same result.
+  // A first line much shorter than the rest makes the estimate long: it is
+  // bounded, and the result is the same.
   const std::string uneven = "1 0 0 0 0 0 0 1\n" + text;
   const auto grown = read_ok<SE3>(uneven);
-  REQUIRE(grown.observations.size() == 1101);
+  REQUIRE(grown.observations.size() == kLines + 1);
   REQUIRE(std::equal(memory.observations.begin(), memory.observations.end(),
                      grown.observations.begin() + 1));
+  using bireg::io::detail::reservation;
+  REQUIRE(reservation(std::size_t{1} << 40, 16) == bireg::io::detail::kMaxReservedLines);
+  REQUIRE(reservation(std::numeric_limits<std::size_t>::max(), 1) ==
+          bireg::io::detail::kMaxReservedLines);
+  REQUIRE(reservation(0, 50) == 1);
+  REQUIRE(reservation(49000, 49) == 1001 + 1001 / 8);
 }
 
 TEST_CASE("a quaternion's rotation is taken as a rotation, whatever element_tolerance", "[io]") {
@@ -396,9 +409,32 @@ TEST_CASE("a quaternion's rotation is taken as a rotation, whatever element_tole
     REQUIRE((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-15);
     REQUIRE(r.determinant() == Approx(1).margin(1e-15));
   }
-  // A matrix line is still checked.
+  // A matrix line is still checked, and a tolerance that is not a
+  // non-negative number is refused.
   const auto error = read_error<SE3>("0 1 0 0 0 0 1 0 0 0 0 1.001 0 0 0 0 1\n");
   REQUIRE(error.message.find("not an element of SE3") != std::string::npos);
+  for (const double tolerance : {-1.0, std::nan("")}) {
+    options.element_tolerance = tolerance;
+    const auto refused = read_error<SE3>("0 1 2 3 0 0 0 1\n", options);
+    REQUIRE(refused.line == 0);
+    REQUIRE(refused.message == "element_tolerance must be a non-negative number");
+  }
+}
+
+TEST_CASE("a quaternion whose squares overflow is normalised, not turned into the identity",
+          "[io]") {
+  // (x, y, z, w) = (1e200, 1e200, 0, 0): the half turn about (1, 1, 0).
+  bireg::io::ReadOptions project;
+  project.project = true;
+  const auto tum = read_ok<SE3>("0 1 2 3 1e200 1e200 0 0\n1 1 2 3 0 0 0 1\n", project);
+  Eigen::Matrix3d half_turn;
+  half_turn << 0, 1, 0, 1, 0, 0, 0, 0, -1;
+  REQUIRE((tum.observations[0].topLeftCorner<3, 3>() - half_turn).cwiseAbs().maxCoeff() < 1e-15);
+  REQUIRE(std::isfinite(tum.projection_correction));
+  REQUIRE(tum.projection_correction == Approx(std::sqrt(2.0) * 1e200));
+  // Without --project such a norm is far from 1, and says so.
+  const auto error = read_error<SE3>("0 1 2 3 1e200 1e200 0 0\n");
+  REQUIRE(error.message == "quaternion norm 1.41421e+200 is far from 1 (--project normalises it)");
 }
 
 TEST_CASE("timestamps: exact differences at 1.7e18 ns and 1.7e9 s", "[io]") {

@@ -20,7 +20,7 @@
 // seconds apart, auto (the default) choosing the spacing by
 // cross-validation as bireg_smooth --method spline does (--cv-table FILE
 // writes that curve). The JSON then holds the curve: "degree",
-// "knot_spacing", "knots" (seconds after t_min), "control_points" (one
+// "knot_spacing", "knots" (covariates after t_min), "control_points" (one
 // matrix each), the status and diagnostics and, for auto, a
 // "knot_selection" object with every spacing tried. --output-trajectory
 // writes the spline at every input time. The geodesic's solver, series,
@@ -97,6 +97,7 @@
 #include "bireg/groups/so2.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression/options.hpp"
+#include "bireg/spline_regression.hpp"
 #include "bireg/version.hpp"
 #include "cli_common.hpp"
 #include "entry_points.hpp"
@@ -161,8 +162,9 @@ std::string help_text() {
       tolerance +
       ")\n"
       "  --max-iter K              iteration limit; also spelt --max-iterations (default " +
-      std::to_string(defaults.max_iterations) +
-      ")\n"
+      std::to_string(defaults.max_iterations) + "; " +
+      std::to_string(bireg::SplineOptions<double>().max_iterations) +
+      " with --model spline)\n"
       "  --loss L                  huber, cauchy, tukey: fit robustly and flag outliers (default "
       "none)\n"
       "  --loss-scale C            the loss's constant, Mahalanobis units (default 95% "
@@ -180,7 +182,7 @@ std::string help_text() {
       "  --knot-spacing S|auto     the spline's largest knot spacing in seconds, or auto: "
       "cross-validated (default auto)\n"
       "  --cv-table FILE           CSV of the knot spacings tried by auto (default none)\n"
-      "  --output-trajectory FILE  write the fitted geodesic at every input time (default none)\n"
+      "  --output-trajectory FILE  write the fitted curve at every input time (default none)\n"
       "  --output-format F         the format of --output-trajectory (default the input's)\n"
       "  --threads N               threads; the output does not depend on N (default every core: " +
       std::to_string(defaults.threads) +
@@ -352,13 +354,6 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
     return "--output-format goes with --output-trajectory FILE";
   }
   if (auto error = bireg_cli::check_input_options(command.input)) return error;
-  if (command.method == bireg::Method::series && !order_given)
-    return "--method series needs --order M";
-  if (command.method != bireg::Method::series && order_given) {
-    return "--order applies to --method series only";
-  }
-  if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
-  if (command.seed && command.permutations == 0) return "--seed goes with --permutations B";
   // Each model's own options, refused with the other.
   for (const char* option : {"--degree", "--knot-spacing", "--cv-table"}) {
     if (!command.spline && given.count(option)) {
@@ -375,6 +370,13 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
     return "--group auto chooses among geodesic motion models: give the group with --model "
            "spline";
   }
+  if (command.method == bireg::Method::series && !order_given)
+    return "--method series needs --order M";
+  if (command.method != bireg::Method::series && order_given) {
+    return "--order applies to --method series only";
+  }
+  if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
+  if (command.seed && command.permutations == 0) return "--seed goes with --permutations B";
   if (command.cv_table.size() && command.knot_spacing) {
     return "--cv-table goes with --knot-spacing auto";
   }

@@ -82,9 +82,9 @@ int run(const FitCommand& command) {
     }
   }
 
-  // The knots in seconds after t_min (the input's earliest timestamp), as
-  // the covariates the fit saw; the curve is defined between the first
-  // and the last.
+  // The knots in the covariate's unit (seconds for the time formats) after
+  // t_min, the input's earliest covariate, as the fit saw them; the curve is
+  // defined between the first and the last.
   std::string knots, points;
   for (std::size_t k = 0; k <= spline.segments(); ++k) {
     knots += (k ? ", " : "") +
@@ -131,9 +131,12 @@ int run(const FitCommand& command) {
     return kExitWriteError;
   }
   if (!fit.ok()) {
-    std::fprintf(stderr, "bireg_fit: %s: the spline fit did not converge (%s)%s; exit code 3\n",
-                 name.c_str(), bireg::to_string(fit.status),
-                 fit.message.empty() ? "" : (": " + fit.message).c_str());
+    const std::string why = fit.status == bireg::Status::max_iterations
+                                ? "the iteration limit (--max-iter) was reached first"
+                            : fit.message.empty() ? "no step reduced the estimating equations"
+                                                  : fit.message;
+    std::fprintf(stderr, "bireg_fit: %s: the spline fit did not converge (%s): %s; exit code 3\n",
+                 name.c_str(), bireg::to_string(fit.status), why.c_str());
     return kExitNotConverged;
   }
   return 0;
@@ -146,7 +149,12 @@ int run_spline(const FitCommand& command) {
   if (command.group == "SO3") return run<bireg::SO3<double>>(command);
   if (command.group == "SE2") return run<bireg::SE2<double>>(command);
   if (command.group == "SE3") return run<bireg::SE3<double>>(command);
-  return fail("--model spline fits SO2, SO3, SE2 and SE3, not " + command.group);
+  for (const char* other : {"Sim3", "SL3", "GLp3"}) {
+    if (command.group == other) {
+      return fail("--model spline fits SO2, SO3, SE2 and SE3, not " + command.group);
+    }
+  }
+  return fail("unknown group '" + command.group + "' (--model spline fits SO2, SO3, SE2 or SE3)");
 }
 
 }  // namespace bireg_cli

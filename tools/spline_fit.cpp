@@ -3,6 +3,7 @@
 #include "spline_fit.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -79,7 +80,11 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
   }
   out.fit = bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
   const bireg::SplineResult<G>& fit = out.fit;
-  if (fit.status == bireg::Status::invalid_input) return fail(tool, name + ": " + fit.message);
+  if (fit.status == bireg::Status::invalid_input) {
+    const std::uint64_t line =
+        fit.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(fit.bad_index)] : 0;
+    return fail(tool, bireg_cli::where(name, line) + ": " + fit.message);
+  }
   // Near the log's cut locus (SplineResult::beyond_domain): say where.
   if (fit.ok() && fit.largest_residual_angle > bireg::kBeyondDomainAngle<double>) {
     const auto observation = static_cast<std::size_t>(fit.largest_residual_observation);

@@ -39,6 +39,7 @@
 // Never throws on bad input: every problem is a ParseError naming the line.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -122,6 +123,9 @@ constexpr bool can_project() {
 struct ReadOptions {
   std::optional<Format> format;  // empty: detect from the content
   bool project = false;
+  // How far a matrix or KITTI line's rotation may be from orthonormal (a
+  // non-negative number); a rotation made from a normalised quaternion (TUM,
+  // EuRoC) is one to rounding and is not checked.
   double element_tolerance = 1e-6;
   // kitti: the timestamp of every pose, in order; null: frame indices.
   const std::vector<Timestamp>* times = nullptr;
@@ -292,7 +296,14 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
     time_token = tokens[0];
     if (auto problem = parse(1, 7)) return problem;
     const double w = x[qw], a = x[qx], b = x[qx + 1], c = x[qx + 2];
-    const double norm = std::sqrt(w * w + a * a + b * b + c * c);
+    double norm = std::sqrt(w * w + a * a + b * b + c * c);
+    if (!std::isfinite(norm)) {
+      // The squares overflowed (components beyond 1e154): scaled by the
+      // largest first, the norm is finite.
+      const double largest = std::max({std::abs(w), std::abs(a), std::abs(b), std::abs(c)});
+      const double sw = w / largest, sa = a / largest, sb = b / largest, sc = c / largest;
+      norm = largest * std::sqrt(sw * sw + sa * sa + sb * sb + sc * sc);
+    }
     if (options.project) {
       if (!(norm >= 1e-6)) {
         char buffer[64];
@@ -363,17 +374,28 @@ inline bool mentions_timestamp(std::string_view line) {
   return false;
 }
 
-// Reserves room for the lines left, estimated from the first data line's
-// length with an eighth to spare (lines vary in their digits): without it
-// the vectors double as they fill, copying the observations and touching
-// their memory twice (about a fifth of the reading time of a 1e6-line
-// file). Reserved memory that is never written costs no physical memory;
-// a first line much shorter than the rest only makes the estimate short,
-// and the vectors then grow as before.
+// At most this many observations are reserved ahead (about 200 MB for
+// 4 x 4 poses with their timestamps); beyond, the vectors grow as they fill.
+inline constexpr std::size_t kMaxReservedLines = std::size_t{1} << 20;
+
+// How many observations to reserve for the lines left, estimated from the
+// first data line's length with an eighth to spare (lines vary in their
+// digits), at most kMaxReservedLines. Without it the vectors double as they
+// fill, copying the observations and touching their memory twice (about a
+// fifth of the reading time of a 1e6-line file). A first line longer than
+// the rest makes the estimate short (the vectors then grow as before), a
+// shorter one makes it long, by at most kMaxReservedLines entries.
+inline std::size_t reservation(std::size_t remaining_bytes, std::size_t line_bytes) {
+  const std::size_t lines_left = remaining_bytes / (line_bytes > 0 ? line_bytes : 1);
+  if (lines_left >= kMaxReservedLines) return kMaxReservedLines;  // and no overflow below
+  const std::size_t estimate = 1 + lines_left;
+  const std::size_t room = estimate + estimate / 8;
+  return room < kMaxReservedLines ? room : kMaxReservedLines;
+}
+
 template <class G>
 void reserve_for(std::size_t remaining_bytes, std::size_t line_bytes, Trajectory<G>& out) {
-  const std::size_t estimate = 1 + remaining_bytes / line_bytes;
-  const std::size_t room = estimate + estimate / 8;
+  const std::size_t room = reservation(remaining_bytes, line_bytes);
   out.observations.reserve(room);
   out.timestamps.reserve(room);
   out.lines.reserve(room);
@@ -389,6 +411,9 @@ std::optional<ParseError> read_trajectory(ByteSource& source, const ReadOptions&
   out = Trajectory<G>();
   if (options.format && !reads<G>(*options.format)) {
     return ParseError{0, unsupported_format_message<G>(*options.format)};
+  }
+  if (!(options.element_tolerance >= 0)) {
+    return ParseError{0, "element_tolerance must be a non-negative number"};
   }
   if (options.project && !can_project<G>()) {
     return ParseError{0, std::string("--project applies to SO2, SO3, SE2 and SE3, not ") + G::name};

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstring>
 #include <istream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -85,7 +86,11 @@ class FileSource final : public ByteSource {
     struct stat status;
     if (file_ && fstat(fileno(file_), &status) == 0 && S_ISREG(status.st_mode)) {
       const long at = std::ftell(file_);
-      if (at >= 0 && status.st_size > at) size_ = static_cast<std::size_t>(status.st_size - at);
+      if (at >= 0 && status.st_size > at) {
+        const auto left = static_cast<std::uintmax_t>(status.st_size - at);
+        constexpr std::size_t kLargest = std::numeric_limits<std::size_t>::max();
+        size_ = left > kLargest ? kLargest : static_cast<std::size_t>(left);
+      }
     }
 #endif
   }
@@ -110,7 +115,10 @@ class FileSource final : public ByteSource {
 
  private:
   std::FILE* file_;
-  std::size_t size_ = 0, read_ = 0;  // a regular file's bytes from the start, bytes read
+  // A regular file's bytes from the position at construction (0: not a
+  // regular file), and the bytes read since: a hint, stale if the file
+  // changes or someone else reads the FILE.
+  std::size_t size_ = 0, read_ = 0;
   bool failed_ = false;
   std::string error_;
 };

@@ -152,9 +152,6 @@ struct Timestamp {
 
 namespace detail {
 
-// The exact fixed-point value of a plain decimal token, scaled by 10^-shift
-// (shift 9: nanoseconds to seconds). False when the token is not a plain
-// decimal or needs more than 18 integer or 18 fractional digits.
 inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
                                   std::uint64_t& fraction);
 
@@ -173,7 +170,11 @@ inline void set_floor_form(bool negative, std::uint64_t w, std::uint64_t f, std:
   }
 }
 
-// exact_decimal's common case in one pass: a sign, at most 19 digits in
+// The exact fixed-point value of a plain decimal token, scaled by 10^-shift
+// (shift 9: nanoseconds to seconds). False when the token is not a plain
+// decimal or needs more than 18 integer or 18 fractional digits.
+//
+// The common case in one pass: a sign, at most 19 digits in
 // all and an optional point, no exponent. The digits as one integer v
 // scaled by 10^-(fraction digits + shift), split at the point.
 inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
@@ -225,7 +226,8 @@ inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
   return true;
 }
 
-// Any plain decimal, exponent included.
+// exact_decimal for any plain decimal, exponent included: the digits one
+// by one, each at its decimal position.
 inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
                                   std::uint64_t& fraction) {
   static constexpr std::uint64_t kPow10[19] = {1ULL,
@@ -300,8 +302,6 @@ inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& w
 
 }  // namespace detail
 
-// Reads a timestamp token in `unit`: a finite number (parse_number's rules
-// and messages), kept as text and, when possible, exactly.
 // The timestamp of a token that parse_number has read as `value`.
 inline void timestamp_of_number(std::string_view token, double value, TimeUnit unit,
                                 Timestamp& out) {
@@ -311,6 +311,8 @@ inline void timestamp_of_number(std::string_view token, double value, TimeUnit u
   out.exact = detail::exact_decimal(token, shift, out.whole, out.fraction);
 }
 
+// Reads a timestamp token in `unit`: a finite number (parse_number's rules
+// and messages), kept as text and, when possible, exactly.
 inline std::optional<std::string> parse_timestamp(std::string_view token, TimeUnit unit,
                                                   Timestamp& out) {
   double value = 0;

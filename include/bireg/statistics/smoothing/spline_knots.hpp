@@ -92,18 +92,25 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
   using Covariance = Eigen::Matrix<Scalar, G::dof, G::dof>;
   KnotSpacingSelection<Scalar> selection;
   selection.grid = grid;
+  // Nothing can be tried: every grid value refused for the one reason, so
+  // that the per-value vectors always match the grid.
+  const auto refuse_all = [&](const std::string& message) {
+    selection.message = message;
+    selection.criterion.assign(grid.size(), std::numeric_limits<Scalar>::infinity());
+    selection.failures.assign(grid.size(), 0);
+    selection.refusals.assign(grid.size(), "not tried: " + message);
+    return selection;
+  };
   const std::size_t n = observations.size();
   if (grid.empty() || folds < 2 || covariates.size() != n || n < 2 * folds) {
-    selection.message =
+    return refuse_all(
         "knot spacing selection needs a grid, at least 2 folds and at least 2 "
-        "observations per fold";
-    return selection;
+        "observations per fold");
   }
   for (std::size_t v = 0; v < grid.size(); ++v) {
     if (!(grid[v] > 0) || (v > 0 && !(grid[v] > grid[v - 1]))) {
-      selection.message =
-          "the knot spacing grid must be positive and ascending (value " + std::to_string(v) + ")";
-      return selection;
+      return refuse_all("the knot spacing grid must be positive and ascending (value " +
+                        std::to_string(v) + ")");
     }
   }
   std::vector<std::size_t> order(n);
