@@ -282,7 +282,10 @@ TEST_CASE("read_numbers: one pass gives split_tokens' tokens and parse_number's 
     const bool all = bireg::io::read_numbers(line, tokens, numbers, had_comma);
     bireg::io::split_tokens(line, expected, &expected_comma);
     CAPTURE(line);
-    REQUIRE(tokens == expected);
+    // As strings: Catch prints a std::string_view only where its own
+    // library was built with C++17 string_view support.
+    REQUIRE(std::vector<std::string>(tokens.begin(), tokens.end()) ==
+            std::vector<std::string>(expected.begin(), expected.end()));
     REQUIRE(had_comma == expected_comma);
     // True exactly when from_chars reads every token whole as a finite
     // number (strtod's extra syntax, '+2' or hexadecimal, and underflow are
