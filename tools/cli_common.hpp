@@ -253,6 +253,17 @@ inline std::optional<std::string> read_query_times(const std::string& path,
   return error;
 }
 
+// Flushes stdout after the JSON: false, with "<tool>: <stdout>: write
+// error: reason" on stderr, when it could not be written (disk full, a
+// closed pipe); the caller then exits with kExitWriteError.
+inline bool stdout_written(const char* tool) {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return true;
+  std::fprintf(stderr, "%s: <stdout>: write error: %s\n", tool,
+               errno != 0 ? std::strerror(errno) : "unknown");
+  return false;
+}
+
 // Writes `text` to the file `path`; returns "path: reason" when it cannot.
 inline std::optional<std::string> write_text_file(const std::string& path,
                                                   const std::string& text) {

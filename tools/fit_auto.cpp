@@ -167,12 +167,7 @@ int run_auto(const AutoCommand& command) {
   std::printf(" \"t_min\": %s, \"t_max\": %s,\n \"model_selection\": [%s]}\n",
               io::render_timestamp(trajectory.origin, io::TimeUnit::seconds).c_str(),
               io::render_timestamp(trajectory.last, io::TimeUnit::seconds).c_str(), table.c_str());
-  errno = 0;
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "bireg_fit: <stdout>: write error: %s\n",
-                 errno != 0 ? std::strerror(errno) : "unknown");
-    return kExitWriteError;
-  }
+  if (!stdout_written("bireg_fit")) return kExitWriteError;
   return prediction ? 0 : kExitNotConverged;
 }
 

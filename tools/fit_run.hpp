@@ -251,12 +251,7 @@ int run(const FitCommand& command) {
   if (!confidence_json.empty()) std::printf(",\n \"confidence\": %s", confidence_json.c_str());
   if (!trend_json.empty()) std::printf(",\n \"trend_test\": %s", trend_json.c_str());
   std::printf("}\n");
-  errno = 0;
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "bireg_fit: <stdout>: write error: %s\n",
-                 errno != 0 ? std::strerror(errno) : "unknown");
-    return kExitWriteError;
-  }
+  if (!stdout_written("bireg_fit")) return kExitWriteError;
   if (!result.ok() || (robust && !robust->ok())) {
     // Exit code 3 says why on stderr, in the top-level status's words.
     const std::string why = robust_failed ? "the robust fit did not converge (" +

@@ -124,12 +124,7 @@ int run(const FitCommand& command) {
     std::printf(",\n \"knot_selection\": %s", selection_json(*spline_fit.selection).c_str());
   }
   std::printf("}\n");
-  errno = 0;
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "bireg_fit: <stdout>: write error: %s\n",
-                 errno != 0 ? std::strerror(errno) : "unknown");
-    return kExitWriteError;
-  }
+  if (!stdout_written("bireg_fit")) return kExitWriteError;
   if (!fit.ok()) {
     const std::string why = fit.status == bireg::Status::max_iterations
                                 ? "the iteration limit (--max-iter) was reached first"

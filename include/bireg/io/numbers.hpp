@@ -13,6 +13,7 @@
 // microsecond digits become covariates that keep every digit.
 #pragma once
 
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -152,6 +153,15 @@ struct Timestamp {
 
 namespace detail {
 
+// 10^k for k = 0..18 (10^18 is kFractionScale).
+inline constexpr std::array<std::uint64_t, 19> kPowersOf10 = [] {
+  std::array<std::uint64_t, 19> powers{};
+  powers[0] = 1;
+  for (std::size_t k = 1; k < powers.size(); ++k)
+    powers[k] = powers[k - 1] * 10;
+  return powers;
+}();
+
 inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
                                   std::uint64_t& fraction);
 
@@ -179,25 +189,6 @@ inline void set_floor_form(bool negative, std::uint64_t w, std::uint64_t f, std:
 // scaled by 10^-(fraction digits + shift), split at the point.
 inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
                           std::uint64_t& fraction) {
-  static constexpr std::uint64_t kPow10[19] = {1ULL,
-                                               10ULL,
-                                               100ULL,
-                                               1000ULL,
-                                               10000ULL,
-                                               100000ULL,
-                                               1000000ULL,
-                                               10000000ULL,
-                                               100000000ULL,
-                                               1000000000ULL,
-                                               10000000000ULL,
-                                               100000000000ULL,
-                                               1000000000000ULL,
-                                               10000000000000ULL,
-                                               100000000000000ULL,
-                                               1000000000000000ULL,
-                                               10000000000000000ULL,
-                                               100000000000000000ULL,
-                                               1000000000000000000ULL};
   std::size_t i = 0;
   const bool negative = !s.empty() && s[0] == '-';
   if (!s.empty() && (s[0] == '-' || s[0] == '+')) ++i;
@@ -218,11 +209,11 @@ inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
   const int scale = (fraction_digits < 0 ? 0 : fraction_digits) + shift;
   // 19 digits fit in 64 bits; the whole seconds must stay below 1e18.
   if (i != s.size() || digits == 0 || digits > 19 || scale > 18 ||
-      v / kPow10[scale] >= kFractionScale) {
+      v / kPowersOf10[scale] >= kFractionScale) {
     return exact_decimal_general(s, shift, whole, fraction);
   }
-  set_floor_form(negative, v / kPow10[scale], (v % kPow10[scale]) * kPow10[18 - scale], whole,
-                 fraction);
+  set_floor_form(negative, v / kPowersOf10[scale],
+                 (v % kPowersOf10[scale]) * kPowersOf10[18 - scale], whole, fraction);
   return true;
 }
 
@@ -230,25 +221,6 @@ inline bool exact_decimal(std::string_view s, int shift, std::int64_t& whole,
 // by one, each at its decimal position.
 inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& whole,
                                   std::uint64_t& fraction) {
-  static constexpr std::uint64_t kPow10[19] = {1ULL,
-                                               10ULL,
-                                               100ULL,
-                                               1000ULL,
-                                               10000ULL,
-                                               100000ULL,
-                                               1000000ULL,
-                                               10000000ULL,
-                                               100000000ULL,
-                                               1000000000ULL,
-                                               10000000000ULL,
-                                               100000000000ULL,
-                                               1000000000000ULL,
-                                               10000000000000ULL,
-                                               100000000000000ULL,
-                                               1000000000000000ULL,
-                                               10000000000000000ULL,
-                                               100000000000000000ULL,
-                                               1000000000000000000ULL};
   std::size_t i = 0;
   bool negative = false;
   if (i < s.size() && (s[i] == '+' || s[i] == '-')) negative = s[i++] == '-';
@@ -289,9 +261,9 @@ inline bool exact_decimal_general(std::string_view s, int shift, std::int64_t& w
     if (d == 0) continue;
     if (position >= 18 || position < -18) return false;
     if (position >= 0) {
-      w += static_cast<std::uint64_t>(d) * kPow10[position];
+      w += static_cast<std::uint64_t>(d) * kPowersOf10[position];
     } else {
-      f += static_cast<std::uint64_t>(d) * kPow10[18 + position];
+      f += static_cast<std::uint64_t>(d) * kPowersOf10[18 + position];
     }
   }
   if (!any_digit) return false;
