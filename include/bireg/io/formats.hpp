@@ -235,7 +235,8 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
   Eigen::Matrix3d r;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   bool from_rotation = false;  // r (and p) hold the pose
-  bool quaternion = false;     // r is a normalised quaternion's: a rotation to rounding
+  // TUM and EuRoC give a quaternion, normalised below: a rotation to rounding.
+  const bool quaternion = format == Format::tum || format == Format::euroc;
   if (format == Format::matrix) {
     const std::size_t expected = 1 + n * n;
     if (tokens.size() != expected) return found(std::to_string(expected) + " numbers");
@@ -320,7 +321,6 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
     r = rotation_of_quaternion(w / norm, a / norm, b / norm, c / norm);
     p << x[1], x[2], x[3];
     from_rotation = true;
-    quaternion = true;
   }
   if (from_rotation) {
     if constexpr (is_se3 || is_sim3) {
