@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -85,7 +86,7 @@ struct IterationRecord {
   std::vector<std::pair<typename G::Element, typename G::Element>> iterates;  // if recorded
   // Stopping::predicted stopped after an unevaluated step (see there).
   bool unevaluated = false;
-  // The caller's Decision stopped the iteration before it converged (see
+  // The caller's decision stopped the iteration before it converged (see
   // iterate): `status` is then meaningless, the fit is unfinished.
   bool decided = false;
 
@@ -101,35 +102,54 @@ struct IterationRecord {
 
 // A caller that needs a decision about the fit rather than the fit (the
 // trend test: is the permuted statistic beyond the observed one?) passes a
-// Decision to iterate: decided(residuals, theta) is called at every
+// decision to iterate: decided(residuals, theta) is called at every
 // evaluated state that has not converged, with that state's residuals and
 // theta = |d_k| / |d_{k-1}|, the contraction factor estimated from the
 // step proposed there and the full step that reached it (0 where unknown:
 // at the start, after a halved step). Returning true stops the iteration
-// there (IterationRecord::decided). NoDecision never stops it.
-struct NoDecision {
-  template <class Residuals, class Scalar>
-  bool operator()(const Residuals&, Scalar) const {
-    return false;
+// there (IterationRecord::decided). A DecisionRef refers to the caller's
+// decision (which must outlive it) through one function pointer, so that
+// iterate is compiled once whatever decides: a template parameter
+// instantiated the whole iteration again for the trend test (about a
+// second of a consumer's compile time). The default refers to none and
+// never stops the iteration.
+template <class Tangent, class Scalar>
+class DecisionRef {
+ public:
+  DecisionRef() = default;
+  template <class Decision,
+            class = std::enable_if_t<!std::is_same_v<std::decay_t<Decision>, DecisionRef>>>
+  DecisionRef(Decision& decision)  // NOLINT(google-explicit-constructor): a view
+      : decision_(&decision),
+        call_([](void* d, const std::vector<Tangent>& residuals, Scalar theta) {
+          return bool((*static_cast<Decision*>(d))(residuals, theta));
+        }) {}
+
+  bool operator()(const std::vector<Tangent>& residuals, Scalar theta) const {
+    return call_ != nullptr && call_(decision_, residuals, theta);
   }
+
+ private:
+  void* decision_ = nullptr;
+  bool (*call_)(void*, const std::vector<Tangent>&, Scalar) = nullptr;
 };
 
 // Runs the iteration from (start0, start1), or from (fallback, fallback)
 // when that start is unusable, until it converges, fails, or `decided`
-// stops it (Decision above). Returns the state at the returned endpoints,
+// stops it (DecisionRef above). Returns the state at the returned endpoints,
 // whose residuals are in `residuals` (sized N; see Stopping::predicted for
 // the exception). `record` is reset first, so one record (and one
 // workspace) can serve a sequence of fits without allocating again. Every state it returns has
 // a convergent series and a finite force, hence finite residuals, except
 // when even the fallback start (X = 0) is unusable, which cannot happen.
-template <class G, class Rule, class Observations, class Decision = NoDecision>
+template <class G, class Rule, class Observations>
 State<G> iterate(const Observations& observations, const Problem<typename G::Scalar>& problem,
                  const PsiEvaluation& psi, const Rule& rule,
                  const IterationControl<typename G::Scalar>& control,
                  const typename G::Element& start0, const typename G::Element& start1,
                  const typename G::Element& fallback, std::vector<typename G::Tangent>& residuals,
                  IterationRecord<G>& record, ForceWorkspace<G>* workspace = nullptr,
-                 Decision&& decided = {}) {
+                 DecisionRef<typename G::Tangent, typename G::Scalar> decided = {}) {
   using Scalar = typename G::Scalar;
   using std::isfinite;
   using std::sqrt;
@@ -184,7 +204,7 @@ State<G> iterate(const Observations& observations, const Problem<typename G::Sca
       record.status = Status::converged;
       return state;
     }
-    if (decided(std::as_const(residuals), full_step > 0 ? step_norm / full_step : Scalar(0))) {
+    if (decided(residuals, full_step > 0 ? step_norm / full_step : Scalar(0))) {
       record.decided = true;
       return state;
     }

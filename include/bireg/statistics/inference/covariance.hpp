@@ -83,6 +83,7 @@
 // test compares it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -184,35 +185,51 @@ Matrix square_root(const Matrix& s) {
   return eigen.vectors * root.asDiagonal();
 }
 
-// nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = map
-// force_i, C = sum z z^T = map (sum force force^T) map^T (on C's numerical
-// range: p its rank). `meat_root` is R with R R^T = sum force force^T, so C
-// costs no pass, and C = (map R)(map R)^T is positive semi-definite to
-// rounding relative to its own largest eigenvalue, which its rank needs.
-template <class Map, class Force, class Root>
-typename Map::Scalar satterthwaite(const Map& map, const std::vector<Force>& forces,
-                                   const Root& meat_root) {
-  using Scalar = typename Map::Scalar;
-  constexpr int p = Map::RowsAtCompileTime;
-  using Matrix = Eigen::Matrix<Scalar, p, p>;
-  using Vector = Eigen::Matrix<Scalar, p, 1>;
+// nu_L = p (p + 2) / sum kappa_i^2, kappa_i = z_i^T C^{-1} z_i, z_i = M
+// force_i, C = sum z z^T = M (sum force force^T) M^T (on C's numerical
+// range: p its rank), for the map M of a quantity: the first `rows` rows of
+// `map` (2d x 2d whatever the quantity, the rows below zero, so that one
+// instantiation serves the endpoints, the start, the end and the velocity).
+// `meat_root` is R with R R^T = sum force force^T, so C costs no pass, and
+// C = (M R)(M R)^T is positive semi-definite to rounding relative to its
+// own largest eigenvalue, which its rank needs.
+template <class Matrix, class Force>
+typename Matrix::Scalar satterthwaite(const Matrix& map, int rows, const std::vector<Force>& forces,
+                                      const Matrix& meat_root) {
+  using Scalar = typename Matrix::Scalar;
+  constexpr int n = Matrix::RowsAtCompileTime;
   // Products of 2d-sized matrices are lazy (coefficient-wise) throughout:
   // Eigen's blocked product kernels cost seconds of compile time per shape
   // and win nothing at these sizes.
-  const Map spread = map.lazyProduct(meat_root);
-  const Matrix c = spread.lazyProduct(spread.transpose());
-  const SymmetricEigen<Scalar, p> eigen = symmetric_eigen(c);
-  const Vector& values = eigen.values;
-  const Scalar largest = values[p - 1];
-  Vector inverse_root = Vector::Zero();
-  int rank = 0;
-  for (int k = 0; k < p; ++k) {
-    if (largest > 0 && values[k] > Scalar(1e-10) * largest) {
-      inverse_root[k] = 1 / std::sqrt(values[k]);
-      ++rank;
+  const Matrix spread = map.lazyProduct(meat_root);
+  // C's eigen-decomposition on its rows x rows block, stored compactly
+  // (column-major, leading dimension `rows`) for the Jacobi sweeps.
+  Matrix c_work, vectors;
+  Scalar* c = c_work.data();
+  Scalar* v = vectors.data();
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < rows; ++i) {
+      c[i + j * rows] = spread.row(i).dot(spread.row(j));
+      v[i + j * rows] = i == j ? Scalar(1) : Scalar(0);
     }
   }
-  const Map whitening = inverse_root.asDiagonal() * eigen.vectors.transpose().lazyProduct(map);
+  symmetric_eigen_detail::diagonalize(c, v, rows);
+  Scalar largest = 0;
+  for (int k = 0; k < rows; ++k)
+    largest = std::max(largest, c[k + k * rows]);
+  // The whitening W = Lambda^{-1/2} V^T M on C's numerical range, its other
+  // rows zero: kappa_i = |W force_i|^2.
+  Matrix whitening = Matrix::Zero();
+  int rank = 0;
+  for (int k = 0; k < rows; ++k) {
+    const Scalar value = c[k + k * rows];
+    if (!(largest > 0 && value > Scalar(1e-10) * largest)) continue;
+    const Scalar inverse_root = 1 / std::sqrt(value);
+    for (int i = 0; i < rows; ++i)
+      whitening.row(k) += (inverse_root * v[i + k * rows]) * map.row(i);
+    ++rank;
+  }
+  static_assert(n == Force::RowsAtCompileTime, "forces are 2d-vectors");
   Scalar sum = 0;
   for (const Force& f : forces) {
     const Scalar kappa = whitening.lazyProduct(f).squaredNorm();
@@ -238,13 +255,13 @@ struct ObservationSums {
 };
 
 // What the pass needs besides the residuals: the leverages' matrices (the
-// robust flavour's v_i) and S's square root (the homoscedastic meat).
+// robust flavour's v_i) and S (the homoscedastic meat).
 template <class G>
 struct PassInputs {
   using Matrix2 = Eigen::Matrix<typename G::Scalar, 2, 2>;
   typename G::Tangent x;
   Matrix2 h_inverse, leverage_matrix;
-  typename G::AdMatrix s_root;
+  typename G::AdMatrix s;
   CovarianceFlavour flavour;
 };
 
@@ -288,6 +305,10 @@ ObservationSums<G> sums_by_matrices(const PassInputs<G>& in,
   using AdMatrix = typename G::AdMatrix;
   ObservationSums<G> sums;
   if (in.flavour == CovarianceFlavour::robust) sums.forces.reserve(problem.size());
+  // S = s_root s_root^T, so that each observation's meat is a Gram matrix.
+  const AdMatrix s_root = in.flavour == CovarianceFlavour::homoscedastic
+                              ? square_root(in.s)
+                              : AdMatrix(AdMatrix::Zero());
   for (std::size_t i = 0; i < problem.size(); ++i) {
     const Scalar t = problem.t[i], u = 1 - t, w = problem.w[i];
     if (w == 0) continue;
@@ -300,8 +321,8 @@ ObservationSums<G> sums_by_matrices(const PassInputs<G>& in,
     sums.k10_core.noalias() += (k_weight * end.inverse).lazyProduct(start.jacobian);
     if (in.flavour == CovarianceFlavour::homoscedastic) {
       // w Psi_i S Psi_i^T w, with S = s_root s_root^T.
-      const AdMatrix start_spread = (w * u * start.inverse).lazyProduct(in.s_root);
-      const AdMatrix end_spread = (w * t * end.inverse).lazyProduct(in.s_root);
+      const AdMatrix start_spread = (w * u * start.inverse).lazyProduct(s_root);
+      const AdMatrix end_spread = (w * t * end.inverse).lazyProduct(s_root);
       sums.meat_start.noalias() += start_spread.lazyProduct(start_spread.transpose());
       sums.meat_cross.noalias() += start_spread.lazyProduct(end_spread.transpose());
       sums.meat_end.noalias() += end_spread.lazyProduct(end_spread.transpose());
@@ -372,13 +393,12 @@ ObservationSums<G> sums_by_algebra(const PassInputs<G>& in,
   sums.k10_core = basis.matrix(k10);
   if (in.flavour == CovarianceFlavour::homoscedastic) {
     // sum_{k,l} m_kl B_k S B_l^T = sum_k (B_k S) (sum_l m_kl B_l)^T.
-    const AdMatrix s = in.s_root * in.s_root.transpose();
     const AdMatrix b[4] = {AdMatrix::Identity(), basis.a, basis.a2, basis.n2};
     const auto meat = [&](const Matrix4& m) {
       AdMatrix sum = AdMatrix::Zero();
       for (int k = 0; k < 4; ++k) {
         const AdMatrix combined = m(k, 0) * b[0] + m(k, 1) * b[1] + m(k, 2) * b[2] + m(k, 3) * b[3];
-        sum.noalias() += (b[k] * s) * combined.transpose();
+        sum.noalias() += (b[k] * in.s) * combined.transpose();
       }
       return sum;
     };
@@ -446,7 +466,7 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
     h2.noalias() += problem.w[i] * problem.w[i] * l * l.transpose();
   }
   const Matrix2 h_inverse = h.inverse();
-  const Scalar nu = problem.weight_sum - (h_inverse * h2).trace();
+  const Scalar nu = problem.weight_sum - h_inverse.cwiseProduct(h2.transpose()).sum();
   // Below this nu is rounding noise (N = 2 gives exactly 0 in exact arithmetic).
   const Scalar nu_floor = Scalar(1e-9) * problem.weight_sum;
   if (!(nu > nu_floor)) {
@@ -477,8 +497,7 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   }
 
   const Tangent x = geodesic.displacement();
-  const covariance_detail::PassInputs<G> inputs{x, h_inverse, leverage_matrix,
-                                                covariance_detail::square_root(s), flavour};
+  const covariance_detail::PassInputs<G> inputs{x, h_inverse, leverage_matrix, s, flavour};
   covariance_detail::ObservationSums<G> sums;
   if constexpr (Pass == CovariancePass::fastest &&
                 provides_v<G, capability_detail::ad_algebra_basis>) {
@@ -534,20 +553,23 @@ FitCovariance<G> covariance_of(const Geodesic<G>& geodesic,
   Result result;
   result.effective = {nu, nu, nu, nu};
   if (flavour == CovarianceFlavour::robust) {
-    const Eigen::Matrix<Scalar, d, 2 * d> start_map = Eigen::Matrix<Scalar, d, 2 * d>::Identity();
-    Eigen::Matrix<Scalar, d, 2 * d> end_map = Eigen::Matrix<Scalar, d, 2 * d>::Zero();
-    end_map.template rightCols<d>().setIdentity();
-    Eigen::Matrix<Scalar, d, 2 * d> velocity_map;
-    velocity_map.template leftCols<d>() = -right_jacobian_inverse<G>(Tangent(-x));
-    velocity_map.template rightCols<d>() = right_jacobian_inverse<G>(x);
+    // The maps of the start, the end and the velocity, d x 2d each, as the
+    // top rows of 2d x 2d matrices (satterthwaite reads `rows` rows).
+    EndpointMatrix start_map = EndpointMatrix::Zero(), end_map = EndpointMatrix::Zero(),
+                   velocity_map = EndpointMatrix::Zero();
+    start_map.template topLeftCorner<d, d>().setIdentity();
+    end_map.template topRightCorner<d, d>().setIdentity();
+    velocity_map.template topLeftCorner<d, d>() = -right_jacobian_inverse<G>(Tangent(-x));
+    velocity_map.template topRightCorner<d, d>() = right_jacobian_inverse<G>(x);
+    const auto effective = [&](const EndpointMatrix& map, int rows) {
+      return covariance_detail::satterthwaite(EndpointMatrix(map.lazyProduct(bread)), rows,
+                                              sums.forces, meat_root);
+    };
     result.effective.endpoints =
-        covariance_detail::satterthwaite(EndpointMatrix(bread), sums.forces, meat_root);
-    result.effective.start = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(start_map.lazyProduct(bread)), sums.forces, meat_root);
-    result.effective.end = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(end_map.lazyProduct(bread)), sums.forces, meat_root);
-    result.effective.velocity = covariance_detail::satterthwaite(
-        Eigen::Matrix<Scalar, d, 2 * d>(velocity_map.lazyProduct(bread)), sums.forces, meat_root);
+        covariance_detail::satterthwaite(bread, 2 * d, sums.forces, meat_root);
+    result.effective.start = effective(start_map, d);
+    result.effective.end = effective(end_map, d);
+    result.effective.velocity = effective(velocity_map, d);
     // Zero degrees of freedom: the quantity's robust covariance is zero,
     // every observation that bears on it fitting exactly (two identical
     // observations at t_min pin the start, whatever the others do).
