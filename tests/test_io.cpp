@@ -438,6 +438,13 @@ TEST_CASE("a quaternion whose squares overflow is normalised, not turned into th
   // Without --project such a norm is far from 1, and says so.
   const auto error = read_error<SE3>("0 1 2 3 1e200 1e200 0 0\n");
   REQUIRE(error.message == "quaternion norm 1.41421e+200 is far from 1 (--project normalises it)");
+  // Components near the largest double: the norm overflows even when
+  // scaled, and the quaternion is refused rather than made the identity.
+  for (const auto& options : {project, bireg::io::ReadOptions{}}) {
+    const auto beyond = read_error<SE3>("0 1 2 3 1.5e308 1.5e308 0 0\n", options);
+    REQUIRE(beyond.line == 1);
+    REQUIRE(beyond.message == "quaternion norm beyond the range of double");
+  }
 }
 
 TEST_CASE("timestamps: exact differences at 1.7e18 ns and 1.7e9 s", "[io]") {

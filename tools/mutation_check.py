@@ -109,7 +109,7 @@ MUTANTS = [
            ["test_regression", "test_stability"],
            "beyond_domain threshold moved from 3 pi/4 to 0.95 pi"),
     Mutant("CV1", "include/bireg/statistics/inference/covariance.hpp",
-           "const Scalar nu = problem.weight_sum - (h_inverse * h2).trace();",
+           "const Scalar nu = problem.weight_sum - h_inverse.cwiseProduct(h2.transpose()).sum();",
            "const Scalar nu = problem.weight_sum - 2;",
            ["test_statistics"],
            "degrees of freedom N - 2 regardless of the weights"),

@@ -304,6 +304,9 @@ std::optional<std::string> parse_line(Format format, const std::vector<std::stri
       const double largest = std::max({std::abs(w), std::abs(a), std::abs(b), std::abs(c)});
       const double sw = w / largest, sa = a / largest, sb = b / largest, sc = c / largest;
       norm = largest * std::sqrt(sw * sw + sa * sa + sb * sb + sc * sc);
+      // Beyond the largest double (components near 1.8e308) the norm itself
+      // overflows, and q / |q| would be the zero quaternion: refused.
+      if (!std::isfinite(norm)) return std::string("quaternion norm beyond the range of double");
     }
     if (options.project) {
       if (!(norm >= 1e-6)) {
