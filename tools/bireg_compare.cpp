@@ -469,11 +469,7 @@ bireg::TwoSampleOptions<double> test_options(const Command& command) {
 
 int print(const std::string& json) {
   std::printf("%s\n", json.c_str());
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
-    std::fprintf(stderr, "bireg_compare: <stdout>: write error\n");
-    return kExitWriteError;
-  }
-  return 0;
+  return bireg_cli::stdout_written("bireg_compare") ? 0 : kExitWriteError;
 }
 
 // Why a test that did not run failed, naming the element's file:line.

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -78,6 +79,12 @@ inline std::string display_name(const std::string& path) {
 // "name:line", or just the name for a problem with the whole file.
 inline std::string where(const std::string& name, std::uint64_t line) {
   return line > 0 ? name + ":" + std::to_string(line) : name;
+}
+
+// The source line of observation `index` (a library result's bad_index),
+// or 0 (the whole file) when the result names no observation.
+inline std::uint64_t line_of(const std::vector<std::uint64_t>& lines, std::ptrdiff_t index) {
+  return index >= 0 ? lines[static_cast<std::size_t>(index)] : 0;
 }
 
 // Opens `path` ("-": standard input) for reading as a C stream, or says why

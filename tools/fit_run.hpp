@@ -146,8 +146,7 @@ int run(const FitCommand& command) {
   }
   const auto& result = robust ? robust->fit : plain;
   if (result.status == bireg::Status::invalid_input) {
-    const std::uint64_t line =
-        result.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(result.bad_index)] : 0;
+    const std::uint64_t line = bireg_cli::line_of(trajectory.lines, result.bad_index);
     return fail(bireg_cli::where(name, line) + ": " + result.message);
   }
 

@@ -81,8 +81,7 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
   out.fit = bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);
   const bireg::SplineResult<G>& fit = out.fit;
   if (fit.status == bireg::Status::invalid_input) {
-    const std::uint64_t line =
-        fit.bad_index >= 0 ? trajectory.lines[static_cast<std::size_t>(fit.bad_index)] : 0;
+    const std::uint64_t line = bireg_cli::line_of(trajectory.lines, fit.bad_index);
     return fail(tool, bireg_cli::where(name, line) + ": " + fit.message);
   }
   // Near the log's cut locus (SplineResult::beyond_domain): say where.

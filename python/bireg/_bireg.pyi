@@ -132,6 +132,11 @@ def select_bandwidth(group: str, t: Annotated[NDArray[numpy.float64], dict(shape
 def read_trajectory(path: str, group: str, format: str, project: bool) -> dict:
     """bireg::io::read_trajectory<G>: t, Y, timestamps, lines, format."""
 
+def format_trajectory(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], Y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], format: str, timestamps: Sequence[str] | None, timestamps_format: str) -> str:
+    """
+    bireg::io::format_trajectory<G>: the text of a trajectory file in `format`.
+    """
+
 def two_sample_test(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], statistic: str, variant: str, permutations: int, seed: int, threads: int, first_permutation: int = 0) -> dict:
     """
     bireg::two_sample_test<G>: a dict with the statistic, p-value, means and covariances; relabellings first_permutation .. first_permutation + permutations - 1.
@@ -175,4 +180,19 @@ def compare_velocities(group: str, a: Annotated[NDArray[numpy.float64], dict(sha
 def population_trend(group: str, trends: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None, None), order='C', device='cpu', writable=False)], t0: float, t1: float, level: float, outlier_level: float) -> dict:
     """
     bireg::population_trend<G>: the mean trend, its confidence region, outlying subjects.
+    """
+
+def select_motion_model(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], Y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], folds: int, threads: int) -> dict:
+    """
+    bireg::select_motion_model on SE3 poses or Sim3 similarities: the candidates' table, the recommendation and its poses at t.
+    """
+
+def select_static_or_geodesic(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], Y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], folds: int, threads: int) -> dict:
+    """
+    bireg::select_static_or_geodesic<G>: the two candidates, the recommendation, the mean and the geodesic.
+    """
+
+def select_curve(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], Y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], knot_spacings: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], threads: int) -> dict:
+    """
+    bireg::select_curve<G>: the geodesic, piecewise geodesics and cubic splines scored by the invariant criterion (empty knot_spacings: auto_knot_spacing_grid).
     """

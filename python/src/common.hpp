@@ -214,5 +214,6 @@ void bind_spline(nb::module_& m);
 void bind_statistics(nb::module_& m);
 void bind_io(nb::module_& m);
 void bind_cohorts(nb::module_& m);
+void bind_selection(nb::module_& m);
 
 }  // namespace bireg_python

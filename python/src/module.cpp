@@ -1,6 +1,6 @@
 // The compiled part of the Python package bireg: one binding file per
 // layer of the library (groups, regression with the spline beside it,
-// statistics, io, cohorts). The Python
+// statistics, model selection, io, cohorts). The Python
 // modules in python/bireg/ give it its scikit-learn-style face.
 #include "common.hpp"
 
@@ -15,4 +15,5 @@ NB_MODULE(_bireg, m) {
   bireg_python::bind_statistics(m);
   bireg_python::bind_io(m);
   bireg_python::bind_cohorts(m);
+  bireg_python::bind_selection(m);
 }
