@@ -7,8 +7,9 @@ BENCH_PYTHON_REFERENCE is the C++ program built from
 bench/bench_python_reference.cpp (target bench_python_reference, Release).
 Reports, as medians of the repeats after a warm run:
   * an SE(3) fit at N = 1000 and 1e5 from Python and from C++, and the ratio;
-  * SE3.exp and SE3.log over 1e6 elements, batched from Python and as a C++
-    loop, and the ratios;
+  * SE3.exp and SE3.log over 1e6 elements, batched from Python (into a new
+    array, and into one allocated once, out=, as the C++ loop writes into
+    a vector allocated once) and as a C++ loop, and the ratios;
   * SO3.exp and SO3.log over 1e6 elements against scipy's Rotation, if
     scipy is installed.
 """
@@ -82,6 +83,13 @@ def main():
     print(f"| SE3.exp, 1e6 batched | {python_exp * 1e3:.1f} ms | {cpp_exp * 1e3:.1f} ms | "
           f"{python_exp / cpp_exp:.3f} |")
     print(f"| SE3.log, 1e6 batched | {python_log * 1e3:.1f} ms | {cpp_log * 1e3:.1f} ms | "
+          f"{python_log / cpp_log:.3f} |")
+    g_out, x_out = np.empty_like(g), np.empty_like(x)
+    python_exp = median_seconds(lambda: bireg.SE3.exp(x, out=g_out), args.repeats)
+    python_log = median_seconds(lambda: bireg.SE3.log(g, out=x_out), args.repeats)
+    print(f"| SE3.exp, 1e6 batched, out= | {python_exp * 1e3:.1f} ms | {cpp_exp * 1e3:.1f} ms | "
+          f"{python_exp / cpp_exp:.3f} |")
+    print(f"| SE3.log, 1e6 batched, out= | {python_log * 1e3:.1f} ms | {cpp_log * 1e3:.1f} ms | "
           f"{python_log / cpp_log:.3f} |")
 
     try:

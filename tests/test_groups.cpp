@@ -177,6 +177,18 @@ TEMPLATE_TEST_CASE("is_element accepts near-group matrices and rejects far ones"
   Element not_finite = g;
   not_finite(0, 1) = std::numeric_limits<Scalar>::quiet_NaN();
   REQUIRE_FALSE(G::is_element(not_finite));
+  // SO(3) and SE(3) have no finiteness scan of their own (a non-finite
+  // entry fails one of the comparisons): every entry, each such value.
+  const Scalar infinity = std::numeric_limits<Scalar>::infinity();
+  for (Eigen::Index r = 0; r < g.rows(); ++r) {
+    for (Eigen::Index c = 0; c < g.cols(); ++c) {
+      for (const Scalar bad : {std::numeric_limits<Scalar>::quiet_NaN(), infinity, -infinity}) {
+        Element e = g;
+        e(r, c) = bad;
+        REQUIRE_FALSE(G::is_element(e));
+      }
+    }
+  }
 
   constexpr bool homogeneous = std::is_same_v<G, bireg::SE2<Scalar>> ||
                                std::is_same_v<G, bireg::SE3<Scalar>> ||

@@ -10,11 +10,15 @@ from numpy.typing import NDArray
 def group_info(group: str) -> tuple[int, int]:
     """The group's (algebra dimension, matrix size)."""
 
-def group_exp(group: str, x: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
-    """exp of each row of x: (M, d) -> (M, n, n)."""
+def group_exp(group: str, x: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu', writable=False)], out: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu')] | None) -> object:
+    """
+    exp of each row of x: (M, d) -> (M, n, n), a new array, or written to out (None returned).
+    """
 
-def group_log(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
-    """The principal log of each element: (M, n, n) -> (M, d)."""
+def group_log(group: str, g: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], out: Annotated[NDArray[numpy.float64], dict(shape=(None, None), order='C', device='cpu')] | None) -> object:
+    """
+    The principal log of each element: (M, n, n) -> (M, d), a new array, or written to out (None returned).
+    """
 
 def group_compose(group: str, a: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], b: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)]) -> NDArray[numpy.float64]:
     """a[i] b[i]: (M, n, n) twice -> (M, n, n)."""

@@ -38,16 +38,44 @@ class Group:
                              f"got {a.shape}")
         return np.ascontiguousarray(a.reshape(-1, n, n)), a.shape[:-2]
 
-    # -- operations ----------------------------------------------------------
-    def exp(self, x):
-        """(..., d) -> (..., n, n)."""
-        flat, batch = self._tangents(x)
-        return _bireg.group_exp(self.name, flat).reshape(batch + (self.matrix_size,) * 2)
+    @staticmethod
+    def _out(out, shape, source, what):
+        """The caller's `out` once checked (numpy's convention: C-contiguous
+        float64 of exactly that shape, not overlapping the input), or None:
+        then the C++ allocates the result (in huge pages when large)."""
+        if out is None:
+            return None
+        if not isinstance(out, np.ndarray) or out.dtype != np.float64 or \
+                not out.flags.c_contiguous or not out.flags.writeable:
+            raise ValueError(f"{what}: out must be a writeable C-contiguous float64 ndarray")
+        if out.shape != shape:
+            raise ValueError(f"{what}: out must have shape {shape}, got {out.shape}")
+        if np.may_share_memory(out, source):
+            raise ValueError(f"{what}: out must not overlap the input")
+        return out
 
-    def log(self, g):
-        """(..., n, n) -> (..., d); ValueError where there is no principal log."""
+    # -- operations ----------------------------------------------------------
+    def exp(self, x, out=None):
+        """(..., d) -> (..., n, n). ``out``: an array of that shape to write
+        the result to (and return), as numpy's functions take it."""
+        flat, batch = self._tangents(x)
+        shape = batch + (self.matrix_size,) * 2
+        out = self._out(out, shape, flat, "exp")
+        if out is None:
+            return _bireg.group_exp(self.name, flat, None).reshape(shape)
+        _bireg.group_exp(self.name, flat, out.reshape(-1, *shape[-2:]))
+        return out
+
+    def log(self, g, out=None):
+        """(..., n, n) -> (..., d); ValueError where there is no principal
+        log. ``out`` as for exp."""
         flat, batch = self._elements(g)
-        return _bireg.group_log(self.name, flat).reshape(batch + (self.dim,))
+        shape = batch + (self.dim,)
+        out = self._out(out, shape, flat, "log")
+        if out is None:
+            return _bireg.group_log(self.name, flat, None).reshape(shape)
+        _bireg.group_log(self.name, flat, out.reshape(-1, self.dim))
+        return out
 
     def compose(self, a, b):
         """a b, broadcasting the batch shapes."""

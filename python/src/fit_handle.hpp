@@ -5,6 +5,7 @@
 #pragma once
 
 #include <initializer_list>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -35,6 +36,30 @@ struct GroupFit final : FitHandle {
   std::optional<bireg::RobustResult<G>> robust;
 
   StackView<G> observations() const { return StackView<G>(poses); }
+};
+
+// What fit() was asked, checked: the data Python holds and the options.
+struct FitRequest {
+  std::string group;
+  Vector t;
+  Stack y;
+  Vector w;  // empty: all 1
+  bireg::RegressionOptions<double> options;
+  std::optional<bireg::RobustOptions<double>> robust;  // none: least squares
+};
+
+// bireg::GeodesicRegression<G> (or RobustGeodesicRegression<G>) on a
+// request, with the GIL released; ValueError for refused input. Defined in
+// fit_group.hpp and instantiated for each group in a small file of its own
+// (fit_<group>.cpp), which python/CMakeLists.txt links first: there GCC
+// inlines the per-observation work's helpers (SO3::log into SE3::log, the
+// small-angle series), and the linker keeps those copies. With the copies
+// of the large statistics files a fit of 1e5 SE(3) poses from Python took
+// 11 % longer than in C++; compiled beside the other groups' fits, a fit
+// took about 10 % longer too (bench/README.md, "Python against C++").
+template <class G>
+struct GroupFitter {
+  static std::unique_ptr<FitHandle> fit(const FitRequest& request);
 };
 
 // The handle as the group's fit; the group is the handle's own.

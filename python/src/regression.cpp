@@ -48,34 +48,6 @@ std::optional<bireg::RobustOptions<double>> robust_options(const std::string& lo
 }
 
 template <class G>
-std::unique_ptr<FitHandle> fit_group(const std::string& group, const Vector& t, const Stack& y,
-                                     const Vector& w,
-                                     const bireg::RegressionOptions<double>& options,
-                                     const std::optional<bireg::RobustOptions<double>>& robust) {
-  auto fit = std::make_unique<GroupFit<G>>();
-  fit->group = group;
-  fit->poses = y;
-  fit->covariates = to_vector(t);
-  fit->weights = to_vector(w);
-  fit->options = options;
-  {
-    nb::gil_scoped_release release;
-    if (robust) {
-      fit->robust = bireg::RobustGeodesicRegression<G>(*robust, options)
-                        .fit(fit->observations(), fit->covariates, fit->weights);
-      fit->result = fit->robust->fit;
-    } else {
-      fit->result = bireg::GeodesicRegression<G>(options).fit(fit->observations(), fit->covariates,
-                                                              fit->weights);
-    }
-  }
-  if (fit->result.status == bireg::Status::invalid_input) refuse(fit->result.message);
-  if (fit->robust && fit->robust->status == bireg::RobustStatus::invalid_input)
-    refuse(fit->robust->message);
-  return fit;
-}
-
-template <class G>
 nb::dict robust_report(const GroupFit<G>& fit) {
   nb::dict out;
   if (!fit.robust) return out;
@@ -269,9 +241,9 @@ void bind_regression(nb::module_& m) {
         const bireg::RegressionOptions<double> options =
             regression_options(solver, method, tolerance, max_iterations, threads);
         const auto robust = robust_options(loss, loss_scale);
+        const FitRequest request{group, t, y, w, options, robust};
         return with_group(group, [&](auto tag) {
-          using G = typename decltype(tag)::type;
-          return fit_group<G>(group, t, y, w, options, robust);
+          return GroupFitter<typename decltype(tag)::type>::fit(request);
         });
       },
       nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("weights"), nb::arg("solver"),

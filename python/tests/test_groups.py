@@ -72,3 +72,46 @@ def test_float32_and_non_contiguous_inputs_are_converted(rng):
 def test_refusals_are_value_errors(call, message):
     with pytest.raises(ValueError, match=message):
         call()
+
+
+@pytest.mark.parametrize("name", GROUP_NAMES)
+def test_exp_and_log_write_to_out(name, rng):
+    g = bireg.groups.get(name)
+    x = 0.5 * rng.standard_normal((2, 3, g.dim))
+    e = np.full((2, 3, g.matrix_size, g.matrix_size), np.nan)
+    assert g.exp(x, out=e) is e
+    np.testing.assert_array_equal(e, g.exp(x))
+    v = np.full((2, 3, g.dim), np.nan)
+    assert g.log(e, out=v) is v
+    np.testing.assert_array_equal(v, g.log(e))
+    # One element: the batch shape is ().
+    single = np.empty(g.dim)
+    assert g.log(e[1, 2], out=single) is single
+    np.testing.assert_array_equal(single, v[1, 2])
+
+
+def test_out_is_checked_and_refusals_still_name_the_index(rng):
+    x = rng.standard_normal((5, 6))
+    n = 4
+    for bad, message in [(np.empty((5, n, n), dtype=np.float32), "float64"),
+                         (np.empty((5, n, 2 * n))[:, :, ::2], "C-contiguous"),
+                         (np.empty((4, n, n)), "shape"),
+                         ([[0.0]], "ndarray")]:
+        with pytest.raises(ValueError, match=message):
+            bireg.SE3.exp(x, out=bad)
+    read_only = np.empty((5, n, n))
+    read_only.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable"):
+        bireg.SE3.exp(x, out=read_only)
+    buffer = np.zeros(5 * 16 + 5 * 6)
+    e = buffer[:80].reshape(5, n, n)
+    bireg.SE3.exp(x, out=e)
+    with pytest.raises(ValueError, match="overlap"):
+        bireg.SE3.log(e, out=buffer[10:40].reshape(5, 6))
+    bad = x.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(ValueError, match="index 3"):
+        bireg.SE3.exp(bad, out=np.empty((5, n, n)))
+    e[2, 0, 1] += 0.1
+    with pytest.raises(ValueError, match="index 2"):
+        bireg.SE3.log(e, out=np.empty((5, 6)))

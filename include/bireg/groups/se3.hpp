@@ -162,14 +162,16 @@ struct SE3 {
     return basis;
   }
 
-  // Rotation block in SO(3) (see SO3::is_element) and last row (0, 0, 0, 1),
-  // to within tol (max-norm), all finite.
+  // Rotation block in SO(3) (SO3::is_rotation, read in place) and last row
+  // (0, 0, 0, 1), to within tol (max-norm), all finite. Without branches,
+  // as SO3's: a NaN fails every comparison.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {
-    if (!g.allFinite()) return false;
-    const Scalar last_row = (g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 4>(0, 0, 0, 1))
-                                .cwiseAbs()
-                                .maxCoeff();
-    return last_row <= tol && Rotation::is_element(g.template topLeftCorner<3, 3>(), tol);
+    const bool rotation = Rotation::is_rotation(g.template topLeftCorner<3, 3>(), tol);
+    const Eigen::Matrix<Scalar, 1, 4> last_row_departure =
+        g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 4>(0, 0, 0, 1);
+    const bool last_row = (last_row_departure.array().abs() <= tol).all();
+    const bool finite_translation = g.template topRightCorner<3, 1>().allFinite();
+    return rotation & last_row & finite_translation;
   }
 
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,

@@ -248,22 +248,32 @@ struct SO3 {
   }
 
   // Orthonormal with determinant +1, to within tol (max-norm), and finite.
-  // R^T R - I is symmetric: its six distinct entries are the columns' dot
-  // products, and det R = c0 . (c1 x c2). Written out rather than as a
-  // 3 x 3 product expression, which every file that fits instantiated
-  // (about 15 ns per element either way).
   static bool is_element(const Element& r, Scalar tol = default_element_tolerance<Scalar>()) {
-    using std::abs;
-    if (!r.allFinite()) return false;
-    const auto c0 = r.col(0), c1 = r.col(1), c2 = r.col(2);
-    const Scalar gram[6] = {c0.dot(c0) - 1, c1.dot(c1) - 1, c2.dot(c2) - 1,
-                            c0.dot(c1),     c0.dot(c2),     c1.dot(c2)};
-    bool orthonormal = true;
-    for (const Scalar g : gram)
-      orthonormal = orthonormal && abs(g) <= tol;
-    const Scalar determinant = c0.dot(c1.cross(c2));
-    return orthonormal && abs(determinant - Scalar(1)) <= tol;
+    return is_rotation(r, tol);
   }
+
+  // The same for any 3 x 3 expression (SE(3)'s rotation block, read in
+  // place). R^T R - I is symmetric: its six distinct entries are the
+  // columns' dot products, and det R = c0 . (c1 x c2). The seven tests are
+  // combined without branches: a NaN or an infinity anywhere makes a dot
+  // product NaN or infinite and its test false, so finiteness needs no scan
+  // of its own, and the check costs little more than reading the matrix
+  // (bench/README.md, "Python against C++").
+  template <class Derived>
+  static bool is_rotation(const Eigen::MatrixBase<Derived>& r, Scalar tol) {
+    using std::abs;
+    const auto c0 = r.col(0), c1 = r.col(1), c2 = r.col(2);
+    const Scalar departures[7] = {
+        c0.dot(c0) - 1, c1.dot(c1) - 1, c2.dot(c2) - 1,          c0.dot(c1),
+        c0.dot(c2),     c1.dot(c2),     c0.dot(c1.cross(c2)) - 1};
+    bool within = true;
+    for (const Scalar d : departures) {
+      const bool small = abs(d) <= tol;
+      within = within & small;
+    }
+    return within;
+  }
+
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
   // "Exact form"): F(W) v = s v + f1 W v + f2 W^2 v, W = hat(omega), i.e. the
   // coefficients (s, f1, f2) of the maps (I, W, W^2). The angle must be at

@@ -1,0 +1,4 @@
+// SL(3)'s fit, compiled alone (fit_handle.hpp, GroupFitter, says why).
+#include "fit_group.hpp"
+
+template struct bireg_python::GroupFitter<bireg::SL3<double>>;
