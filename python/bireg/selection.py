@@ -35,21 +35,30 @@ class SelectionWarning(UserWarning):
 
 
 @dataclass(frozen=True)
-class MotionCandidate:
-    """One motion model of ``select_motion_model`` (``bireg::CandidateReport``)."""
+class Candidate:
+    """What every row of a selection's table has: the model, its parameter
+    count k, whether it was scored (``note`` says why not), log det S_r with
+    the eigenvalue floor, the criterion, whether it is within the margin of
+    the best, and whether it is the recommendation."""
 
     model: str
     parameters: int
     fitted: bool
     note: str
+    log_det: Optional[float]
+    criterion: Optional[float]
+    within_margin: bool
+    recommended: bool
+
+
+@dataclass(frozen=True)
+class MotionCandidate(Candidate):
+    """One motion model of ``select_motion_model`` (``bireg::CandidateReport``)."""
+
     rotation_rms_degrees: Optional[float]
     translation_rms: Optional[float]
     log_scale_rms: Optional[float]  # Sim3 data only
-    log_det: Optional[float]
-    criterion: Optional[float]
     cv_error: Optional[float]       # mean held-out |r|^2; None without cross-validation
-    within_margin: bool
-    recommended: bool
 
 
 @dataclass(frozen=True)
@@ -66,19 +75,11 @@ class MotionModelSelection:
 
 
 @dataclass(frozen=True)
-class TrendCandidate:
+class TrendCandidate(Candidate):
     """The static or the geodesic candidate (``bireg::TrendCandidate``)."""
 
-    model: str
-    parameters: int
-    fitted: bool
-    note: str
     residual_rms: Optional[float]
-    log_det: Optional[float]
-    criterion: Optional[float]
     cv_error: Optional[float]
-    within_margin: bool
-    recommended: bool
 
 
 @dataclass(frozen=True)
@@ -98,23 +99,15 @@ class TrendSelection:
 
 
 @dataclass(frozen=True)
-class CurveCandidate:
+class CurveCandidate(Candidate):
     """One curve of ``select_curve`` (``bireg::CurveCandidate``): degree 0
     is the geodesic, 1 a piecewise geodesic, 3 a cubic spline, on
     ``segments`` equal knot spans of ``knot_spacing``."""
 
-    model: str
     degree: int
     segments: int
     knot_spacing: float
-    parameters: int
-    fitted: bool
-    note: str
     residual_rms: Optional[float]
-    log_det: Optional[float]
-    criterion: Optional[float]
-    within_margin: bool
-    recommended: bool
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,19 @@ nb::dict common_row(const Candidate& c, std::string model) {
   return row;
 }
 
+// The table: for each candidate, common_row under name(c), then the
+// columns extra(c, row) adds.
+template <class Candidate, class Name, class Extra>
+nb::list table(const std::vector<Candidate>& candidates, Name name, Extra extra) {
+  nb::list rows;
+  for (const Candidate& c : candidates) {
+    nb::dict row = common_row(c, name(c));
+    extra(c, row);
+    rows.append(row);
+  }
+  return rows;
+}
+
 // The status and message of a selection, or ValueError for a refusal.
 template <class Selection>
 nb::dict selection_header(const Selection& s) {
@@ -77,17 +90,15 @@ nb::dict motion_model(const std::string& group, const Vector& t, const Stack& y,
     s = bireg::select_motion_model(StackView<bireg::SE3d>(y), covariates, options);
   }
   nb::dict out = selection_header(s);
-  nb::list rows;
-  for (const bireg::CandidateReport& c : s.candidates) {
-    nb::dict row = common_row(c, to_string(c.model));
-    row["rotation_rms_degrees"] = scored(c.fitted, c.rotation_rms_degrees);
-    row["translation_rms"] = scored(c.fitted, c.translation_rms);
-    row["log_scale_rms"] =
-        scored(c.fitted && options.group == bireg::PoseGroup::sim3, c.log_scale_rms);
-    row["cv_error"] = optional_number(c.cv_error);
-    rows.append(row);
-  }
-  out["candidates"] = rows;
+  const bool similarities = options.group == bireg::PoseGroup::sim3;
+  out["candidates"] = table(
+      s.candidates, [](const bireg::CandidateReport& c) { return to_string(c.model); },
+      [similarities](const bireg::CandidateReport& c, nb::dict& row) {
+        row["rotation_rms_degrees"] = scored(c.fitted, c.rotation_rms_degrees);
+        row["translation_rms"] = scored(c.fitted, c.translation_rms);
+        row["log_scale_rms"] = scored(c.fitted && similarities, c.log_scale_rms);
+        row["cv_error"] = optional_number(c.cv_error);
+      });
   out["ambiguous"] = s.ambiguous;
   out["recommended"] = s.recommended ? nb::object(nb::str(to_string(*s.recommended))) : nb::none();
   if (s.prediction) {
@@ -112,14 +123,12 @@ nb::dict static_or_geodesic(const Vector& t, const Stack& y, int folds, int thre
     s = bireg::select_static_or_geodesic<G>(StackView<G>(y), covariates, options);
   }
   nb::dict out = selection_header(s);
-  nb::list rows;
-  for (const bireg::TrendCandidate& c : s.candidates) {
-    nb::dict row = common_row(c, to_string(c.model));
-    row["residual_rms"] = scored(c.fitted, c.residual_rms);
-    row["cv_error"] = optional_number(c.cv_error);
-    rows.append(row);
-  }
-  out["candidates"] = rows;
+  out["candidates"] = table(
+      s.candidates, [](const bireg::TrendCandidate& c) { return to_string(c.model); },
+      [](const bireg::TrendCandidate& c, nb::dict& row) {
+        row["residual_rms"] = scored(c.fitted, c.residual_rms);
+        row["cv_error"] = optional_number(c.cv_error);
+      });
   out["recommended"] = s.recommended ? nb::object(nb::str(to_string(*s.recommended))) : nb::none();
   if (s.static_element) {
     out["static_element"] = matrix_array(*s.static_element);
@@ -151,16 +160,14 @@ nb::dict curve(const Vector& t, const Stack& y, const Vector& knot_spacings, int
     s = bireg::select_curve<G>(StackView<G>(y), covariates, options);
   }
   nb::dict out = selection_header(s);
-  nb::list rows;
-  for (const bireg::CurveCandidate& c : s.candidates) {
-    nb::dict row = common_row(c, bireg::describe(c));
-    row["degree"] = c.degree;
-    row["segments"] = static_cast<long long>(c.segments);
-    row["knot_spacing"] = c.knot_spacing;
-    row["residual_rms"] = scored(c.fitted, c.residual_rms);
-    rows.append(row);
-  }
-  out["candidates"] = rows;
+  out["candidates"] = table(
+      s.candidates, [](const bireg::CurveCandidate& c) { return bireg::describe(c); },
+      [](const bireg::CurveCandidate& c, nb::dict& row) {
+        row["degree"] = c.degree;
+        row["segments"] = static_cast<long long>(c.segments);
+        row["knot_spacing"] = c.knot_spacing;
+        row["residual_rms"] = scored(c.fitted, c.residual_rms);
+      });
   if (s.recommended) {
     out["recommended"] = bireg::describe(s.candidates[*s.recommended]);
     out["recommended_index"] = static_cast<long long>(*s.recommended);
