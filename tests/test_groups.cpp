@@ -186,6 +186,7 @@ TEMPLATE_TEST_CASE("is_element accepts near-group matrices and rejects far ones"
         Element e = g;
         e(r, c) = bad;
         REQUIRE_FALSE(G::is_element(e));
+        REQUIRE_FALSE(G::is_element(e, infinity));  // a comparison with inf would pass it
       }
     }
   }

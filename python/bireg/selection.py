@@ -140,7 +140,7 @@ def select_motion_model(t, Y, group="SE3", folds=5, threads=1):
     not depend on ``threads``.
     """
     t, Y = _arrays.trajectory(t, Y, 4)
-    raw = _bireg.select_motion_model(str(group), t, Y, _folds(folds),
+    raw = _bireg.select_motion_model(_groups.get(group).name, t, Y, _folds(folds),
                                      _arrays.positive_int(threads, "threads"))
     _warn_if_nothing(raw)
     return MotionModelSelection(
@@ -149,7 +149,7 @@ def select_motion_model(t, Y, group="SE3", folds=5, threads=1):
         recommended=raw["recommended"], ambiguous=raw["ambiguous"], fitted=raw["fitted"])
 
 
-def select_static_or_geodesic(t, Y, group="SO3", folds=5, threads=1):
+def select_static_or_geodesic(t, Y, group="SE3", folds=5, threads=1):
     """Static against geodesic for Y (N, n, n) of ``group`` at t (N,): does
     the element move along the covariate at all?"""
     g = _groups.get(group)
@@ -164,7 +164,7 @@ def select_static_or_geodesic(t, Y, group="SO3", folds=5, threads=1):
         g1=raw["g1"], interval=raw["interval"])
 
 
-def select_curve(t, Y, group="SO3", knot_spacings=None, threads=1):
+def select_curve(t, Y, group="SE3", knot_spacings=None, threads=1):
     """The geodesic against piecewise geodesics and cubic splines for Y
     (N, n, n) of ``group`` at t (N,). ``knot_spacings`` (in t's units)
     gives the segment counts to try; None: 24 spacings from 1.25 median

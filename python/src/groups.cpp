@@ -74,14 +74,18 @@ void map_elements(const Stack& g, std::size_t stride, double* out, const std::st
   {
     nb::gil_scoped_release release;
     for (std::size_t begin = 0; begin < count && bad < 0; begin += kElementBlock) {
+      // The block's elements up to the first that is not one; those are
+      // mapped first, so that an earlier f that is not finite is named.
       const std::size_t end = std::min(count, begin + kElementBlock);
-      for (std::size_t i = begin; i < end && bad < 0; ++i)
-        if (!G::is_element(elements[i], tolerance)) bad = std::ptrdiff_t(i);
-      for (std::size_t i = begin; i < end && bad < 0; ++i) {
+      std::size_t members = begin;
+      while (members < end && G::is_element(elements[members], tolerance))
+        ++members;
+      for (std::size_t i = begin; i < members && bad < 0; ++i) {
         const auto value = f(elements[i]);
         if (!value.allFinite()) bad = std::ptrdiff_t(i);
         write_row_major(value, out + i * stride);
       }
+      if (bad < 0 && members < end) bad = std::ptrdiff_t(members);
     }
   }
   if (bad >= 0) refuse_at(refusal, bad);
@@ -97,8 +101,9 @@ Output map_elements_new(const Stack& g, std::size_t rows, std::size_t cols,
 }
 
 // The result of a batch of `count` items of `numbers` numbers each: the
-// caller's `out` (numpy's out=; the Python layer checks its shape, dtype and
-// overlap, this its size), or a new array of `shape` when there is none.
+// caller's `out` (numpy's out=: bound with noconvert, so nanobind refuses
+// an array it would have to copy; the Python layer checks its shape, dtype
+// and overlap, this its size), or a new array of `shape` when there is none.
 template <class Array>
 class BatchResult {
  public:
@@ -240,7 +245,7 @@ void bind_groups(nb::module_& m) {
           return exp_batch<G>(x, out);
         });
       },
-      nb::arg("group"), nb::arg("x"), nb::arg("out").none(),
+      nb::arg("group"), nb::arg("x"), nb::arg("out").none().noconvert(),
       "exp of each row of x: (M, d) -> (M, n, n), a new array, or written to out (None "
       "returned).");
   m.def(
@@ -252,7 +257,7 @@ void bind_groups(nb::module_& m) {
           return log_batch<G>(g, out);
         });
       },
-      nb::arg("group"), nb::arg("g"), nb::arg("out").none(),
+      nb::arg("group"), nb::arg("g"), nb::arg("out").none().noconvert(),
       "The principal log of each element: (M, n, n) -> (M, d), a new array, or written to out "
       "(None returned).");
   m.def(

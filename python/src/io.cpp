@@ -1,6 +1,8 @@
 // The io layer: trajectory files (matrix, TUM, EuRoC, KITTI) read by the
 // library's readers and formatted by its writers. A file the reader
 // refuses raises ValueError with path:line and the reader's message.
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -98,6 +100,12 @@ std::string format_file(const Vector& t, const Stack& y, bireg::io::Format forma
         problem = "Y[" + index + "] is not an element of " + G::name;
       } else if (!texts && !std::isfinite(t.data()[i])) {
         problem = "t[" + index + "] is not finite";
+      } else if (texts && std::any_of((*texts)[i].begin(), (*texts)[i].end(), [](char c) {
+                   return bireg::io::is_separator(c) || std::isspace(static_cast<unsigned char>(c));
+                 })) {
+        // parse_number would skip leading blanks, and the text is written
+        // as it stands: a line break would split the line.
+        problem = "timestamp " + index + " holds a space, a separator or a line break";
       } else if (auto bad = bireg::io::parse_timestamp(
                      texts ? (*texts)[i] : bireg::io::format_double(t.data()[i]), unit, times[i])) {
         problem = "timestamp " + index + ": " + *bad;

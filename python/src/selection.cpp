@@ -79,8 +79,8 @@ bireg::ModelSelectionOptions selection_options(int folds, int threads) {
 nb::dict motion_model(const std::string& group, const Vector& t, const Stack& y, int folds,
                       int threads) {
   if (group != "SE3" && group != "Sim3")
-    refuse("select_motion_model: unknown group '" + group +
-           "': expected SE3 (rigid poses) or Sim3 (similarities)");
+    refuse("select_motion_model: group " + group +
+           ": expected SE3 (rigid poses) or Sim3 (similarities)");
   bireg::ModelSelectionOptions options = selection_options(folds, threads);
   options.group = group == "Sim3" ? bireg::PoseGroup::sim3 : bireg::PoseGroup::se3;
   const std::vector<double> covariates = to_vector(t);

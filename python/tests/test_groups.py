@@ -115,3 +115,20 @@ def test_out_is_checked_and_refusals_still_name_the_index(rng):
     e[2, 0, 1] += 0.1
     with pytest.raises(ValueError, match="index 2"):
         bireg.SE3.log(e, out=np.empty((5, 6)))
+
+
+def test_the_first_failure_is_named_and_the_module_refuses_an_out_it_would_copy(rng):
+    # diag(-1, -1, 1) is in GL+(3) but has no principal log; the NaN matrix
+    # after it is not an element. The first of the two is named.
+    batch = np.stack([np.eye(3), np.diag([-1.0, -1.0, 1.0]), np.full((3, 3), np.nan)])
+    with pytest.raises(ValueError, match="index 1"):
+        bireg.GLp3.log(batch)
+    with pytest.raises(ValueError, match="index 1"):
+        bireg.GLp3.log(batch, out=np.empty((3, 9)))
+    # A strided out would be copied by the binding and the result lost:
+    # nanobind is told not to convert it.
+    x = rng.standard_normal((2, 6))
+    with pytest.raises(TypeError):
+        bireg._bireg.group_exp("SE3", x, np.zeros((2, 4, 8))[:, :, ::2])
+    with pytest.raises(TypeError):
+        bireg._bireg.group_log("SE3", bireg.SE3.exp(x), np.zeros((2, 6), dtype=np.float32))

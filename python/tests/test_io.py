@@ -87,6 +87,9 @@ def test_write_refusals_are_value_errors(tmp_path):
         bireg.write_trajectory(out, [0.0, np.inf, 2.0, 3.0], Y)
     with pytest.raises(ValueError, match="timestamp 3"):
         bireg.write_trajectory(out, t, Y, timestamps=["0", "1", "2", "soon"])
+    for blank in (" 1", "\n1", "1\r\n", "1,5", "\v1"):
+        with pytest.raises(ValueError, match="timestamp 1 holds a space, a separator or a line"):
+            bireg.write_trajectory(out, t, Y, timestamps=["0", blank, "2", "3"])
     with pytest.raises(ValueError, match=r"timestamps\[1\] must be a str"):
         bireg.write_trajectory(out, t, Y, timestamps=["0", 1, "2", "3"])
     with pytest.raises(ValueError, match="differ in length"):

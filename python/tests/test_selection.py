@@ -76,7 +76,7 @@ def test_motion_model_table_equals_bireg_fit_auto():
 
 def test_static_poses_recommend_static_and_fit_the_mean(rng):
     t, Y = static_data("SE3", 80, rng)
-    result = bireg.select_motion_model(t, Y, threads=2)
+    result = bireg.select_motion_model(t, Y, group=bireg.SE3, threads=2)
     assert result.recommended == "static"
     assert result.fitted.shape == (80, 4, 4)
     np.testing.assert_allclose(result.fitted, np.broadcast_to(bireg.mean(Y, group="SE3"),

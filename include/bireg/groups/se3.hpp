@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>  // cross()
@@ -166,12 +167,16 @@ struct SE3 {
   // (0, 0, 0, 1), to within tol (max-norm), all finite. Without branches,
   // as SO3's: a NaN fails every comparison.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {
+    using std::abs;
     const bool rotation = Rotation::is_rotation(g.template topLeftCorner<3, 3>(), tol);
     const Eigen::Matrix<Scalar, 1, 4> last_row_departure =
         g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 4>(0, 0, 0, 1);
     const bool last_row = (last_row_departure.array().abs() <= tol).all();
     const bool finite_translation = g.template topRightCorner<3, 1>().allFinite();
-    return rotation & last_row & finite_translation;
+    // An infinite tol passes an infinite entry of the last row.
+    const bool finite_last_row =
+        abs(tol) <= std::numeric_limits<Scalar>::max() || g.template bottomRows<1>().allFinite();
+    return rotation & last_row & finite_translation & finite_last_row;
   }
 
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,

@@ -257,8 +257,8 @@ struct SO3 {
   // columns' dot products, and det R = c0 . (c1 x c2). The seven tests are
   // combined without branches: a NaN or an infinity anywhere makes a dot
   // product NaN or infinite and its test false, so finiteness needs no scan
-  // of its own, and the check costs little more than reading the matrix
-  // (bench/README.md, "Python against C++").
+  // of its own (unless tol is infinite), and the check costs little more
+  // than reading the matrix (bench/README.md, "Python against C++").
   template <class Derived>
   static bool is_rotation(const Eigen::MatrixBase<Derived>& r, Scalar tol) {
     using std::abs;
@@ -271,7 +271,10 @@ struct SO3 {
       const bool small = abs(d) <= tol;
       within = within & small;
     }
-    return within;
+    // An infinite tol passes an infinite departure: then finiteness is
+    // checked apart.
+    const bool finite_tolerance = abs(tol) <= std::numeric_limits<Scalar>::max();
+    return within && (finite_tolerance || r.allFinite());
   }
 
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,
