@@ -100,21 +100,24 @@ Output map_elements_new(const Stack& g, std::size_t rows, std::size_t cols,
   return out.release();
 }
 
-// The result of a batch of `count` items of `numbers` numbers each: the
-// caller's `out` (numpy's out=: bound with noconvert, so nanobind refuses
-// an array it would have to copy; the Python layer checks its shape, dtype
-// and overlap, this its size), or a new array of `shape` when there is none.
+// The result of a batch of shape[0] items of shape[1] x ... numbers each:
+// the caller's `out` (numpy's out=: bound with noconvert, so nanobind
+// refuses an array it would have to copy; the Python layer checks its
+// shape, dtype and overlap, this its size), or a new array of `shape` when
+// there is none.
 template <class Array>
 class BatchResult {
  public:
-  BatchResult(std::optional<Array>& out, std::vector<std::size_t> shape, std::size_t numbers,
-              const char* what) {
+  BatchResult(std::optional<Array>& out, std::vector<std::size_t> shape, const char* what) {
     if (!out) {
       fresh_.emplace(std::move(shape));
       data_ = fresh_->data();
       return;
     }
-    if (out->shape(0) != shape[0] || out->size() != shape[0] * numbers)
+    std::size_t size = 1;
+    for (const std::size_t extent : shape)
+      size *= extent;
+    if (out->shape(0) != shape[0] || out->size() != size)
       throw nb::value_error((std::string(what) + ": out has the wrong shape").c_str());
     data_ = out->data();
   }
@@ -130,7 +133,7 @@ class BatchResult {
 template <class G>
 nb::object exp_batch(const Matrix& x, std::optional<Out3>& out) {
   const std::size_t n = std::size_t(side<G>());
-  BatchResult<Out3> result(out, {x.shape(0), n, n}, n * n, "exp");
+  BatchResult<Out3> result(out, {x.shape(0), n, n}, "exp");
   map_tangents<G>(x, n, n, result.data(), "exp", [](const auto& v) { return G::exp(v); });
   return result.release();
 }
@@ -147,7 +150,7 @@ Output right_jacobian_batch(const Matrix& x) {
 template <class G>
 nb::object log_batch(const Stack& g, std::optional<Out2>& out) {
   const std::size_t d = std::size_t(G::dof);
-  BatchResult<Out2> result(out, {g.shape(0), d}, d, "log");
+  BatchResult<Out2> result(out, {g.shape(0), d}, "log");
   map_elements<G>(g, d, result.data(),
                   std::string("log: no principal logarithm in ") + G::name +
                       " (not an element, or beyond the log's domain) at index",

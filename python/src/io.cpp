@@ -2,7 +2,6 @@
 // library's readers and formatted by its writers. A file the reader
 // refuses raises ValueError with path:line and the reader's message.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -74,7 +73,8 @@ bireg::io::Format format_named(const std::string& name) {
 // The text of a trajectory file: Y[i] at timestamp texts[i] read in
 // `source`'s time unit (converted exactly to `format`'s), or, with no
 // texts, at t[i] seconds written as the shortest text that reads back to
-// it. Refuses, naming the index, a pose that is not a finite element of G,
+// it. Refuses, naming the index, a pose that is not an element of G
+// (is_element: finite, and in G),
 // a time that is not finite and a text that is not a number. The GIL is
 // released while it works.
 template <class G>
@@ -95,16 +95,15 @@ std::string format_file(const Vector& t, const Stack& y, bireg::io::Format forma
     for (std::size_t i = 0; i < count && problem.empty(); ++i) {
       const std::string index = std::to_string(i);
       poses[i] = view[i];
-      if (!poses[i].allFinite() ||
-          !G::is_element(poses[i], bireg::default_element_tolerance<double>())) {
+      if (!G::is_element(poses[i], bireg::default_element_tolerance<double>())) {
         problem = "Y[" + index + "] is not an element of " + G::name;
       } else if (!texts && !std::isfinite(t.data()[i])) {
         problem = "t[" + index + "] is not finite";
-      } else if (texts && std::any_of((*texts)[i].begin(), (*texts)[i].end(), [](char c) {
-                   return bireg::io::is_separator(c) || std::isspace(static_cast<unsigned char>(c));
-                 })) {
-        // parse_number would skip leading blanks, and the text is written
-        // as it stands: a line break would split the line.
+      } else if (texts &&
+                 std::any_of((*texts)[i].begin(), (*texts)[i].end(), bireg::io::is_separator)) {
+        // parse_number would skip leading blanks (is_separator holds every
+        // white space), and the text is written as it stands: a line break
+        // would split the line.
         problem = "timestamp " + index + " holds a space, a separator or a line break";
       } else if (auto bad = bireg::io::parse_timestamp(
                      texts ? (*texts)[i] : bireg::io::format_double(t.data()[i]), unit, times[i])) {
@@ -128,13 +127,7 @@ void bind_io(nb::module_& m) {
       [](const std::string& path, const std::string& group, const std::string& format,
          bool project) {
         std::optional<bireg::io::Format> chosen;
-        if (!format.empty()) {
-          chosen = bireg::io::format_from_string(format);
-          if (!chosen)
-            throw nb::value_error(
-                ("unknown format '" + format + "': expected one of matrix, tum, euroc, kitti")
-                    .c_str());
-        }
+        if (!format.empty()) chosen = format_named(format);
         return with_group(group, [&](auto tag) -> nb::dict {
           using G = typename decltype(tag)::type;
           if (chosen && !bireg::io::reads<G>(*chosen))
