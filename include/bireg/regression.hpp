@@ -104,23 +104,6 @@ class GeodesicRegression {
     return result;
   }
 
-  // The refusal of a start whose estimating equations are not finite,
-  // naming the first observation whose residual there is not.
-  static Rejection unevaluable_start(const std::vector<Tangent>& residuals) {
-    std::ptrdiff_t first_bad = -1;
-    for (std::size_t i = 0; i < residuals.size() && first_bad < 0; ++i) {
-      if (!residuals[i].allFinite()) first_bad = static_cast<std::ptrdiff_t>(i);
-    }
-    const std::string which = first_bad >= 0
-                                  ? "the residual of observation " + std::to_string(first_bad)
-                                  : std::string("the estimating equations");
-    return {which +
-                " is not finite at the start: the data span magnitudes that this scalar type "
-                "cannot invert and take the log of in " +
-                G::name,
-            first_bad};
-  }
-
   // The fit itself, defined below the class (not inline), so that an
   // explicit instantiation declaration (bireg/regression/precompiled.hpp)
   // keeps a consumer from instantiating it again.
@@ -175,21 +158,7 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
 
   // 2. The start.
   const ChartStart<G> chart = chart_start<G>(observations, problem, chunk_pool);
-  if (chart.no_logarithm >= 0) {
-    return rejected({"observation " + std::to_string(chart.no_logarithm) +
-                         " is out of reach of the middle observation: no principal logarithm "
-                         "of f_mid^{-1} f_i (the data leave the domain of " +
-                         G::name + "'s log)",
-                     chart.no_logarithm});
-  }
-  if (chart.too_large >= 0) {
-    return rejected({"observation " + std::to_string(chart.too_large) +
-                         " lies too far from the middle observation: log(f_mid^{-1} f_i) has "
-                         "coordinates above " +
-                         std::to_string(double(largest_tangent<Scalar>())) +
-                         ", whose squares the fit cannot sum in this scalar type",
-                     chart.too_large});
-  }
+  if (auto rejection = chart_rejection<G>(chart)) return rejected(*rejection);
   const Endpoints first = start ? *start : Endpoints(chart.g0, chart.g1);
 
   // 3. The iteration, with the chosen step rule (compiled once for every
@@ -210,7 +179,11 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
     // ill-conditioned to invert and take the log of, next to the
     // others). There is no iterate to report, and no finite diagnostic.
     if (state.series_converges && !state.usable()) {
-      return rejected(unevaluable_start(result.residuals));
+      std::ptrdiff_t first_bad = -1;
+      for (std::size_t i = 0; i < n && first_bad < 0; ++i) {
+        if (!result.residuals[i].allFinite()) first_bad = static_cast<std::ptrdiff_t>(i);
+      }
+      return rejected(unevaluable_start<G>(first_bad));
     }
     if (!state.series_converges) {  // no force was evaluated there: residuals alone
       const Element g0_inverse = G::inverse(state.g0);

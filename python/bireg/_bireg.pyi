@@ -1,6 +1,6 @@
 """bireg's compiled core: bi-invariant regression on Lie groups"""
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Annotated
 
 import numpy
@@ -40,6 +40,9 @@ class FitHandle:
 
     @property
     def group(self) -> str: ...
+
+    @property
+    def chunked(self) -> bool: ...
 
     @property
     def status(self) -> str: ...
@@ -89,6 +92,16 @@ class FitHandle:
 def fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], solver: str, method: str, tol: float, max_iter: int, threads: int, loss: str, loss_scale: float) -> FitHandle:
     """
     bireg::GeodesicRegression<G>::fit (or RobustGeodesicRegression with a loss) of y at t with weights (empty: all 1). ValueError for invalid input.
+    """
+
+def fit_by_chunks(group: str, reduce: Callable, solver: str, method: str, tol: float, max_iter: int) -> FitHandle:
+    """
+    bireg::fit_by_chunks<G>: fit()'s steps on observations held in chunks elsewhere. reduce(request) gets a request's numbers and returns every chunk's chunk_sums numbers, in chunk order. ValueError for invalid input; what reduce raises passes through.
+    """
+
+def chunk_sums(group: str, request: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], offset: int) -> NDArray[numpy.float64]:
+    """
+    bireg::chunk_sums<G> of one chunk (observation i is the whole set's offset + i), request and sums as numbers. The GIL is released.
     """
 
 def spline_fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], degree: int, knot_spacing: float, tol: float, max_iter: int, threads: int) -> dict:

@@ -58,12 +58,17 @@ class GeodesicRegression:
         group = _groups.get(self.group)
         t, Y = _arrays.trajectory(t, Y, group.matrix_size)
         w = _arrays.weights(sample_weight, t.shape[0])
-        self._fit = _bireg.fit(group.name, t, Y, w, self.solver, self.method, float(self.tol),
-                               _arrays.positive_int(self.max_iter, "max_iter"),
-                               _arrays.positive_int(self.threads, "threads"),
-                               "none" if self.loss is None else str(self.loss),
-                               float(self.loss_scale))
-        fit = self._fit
+        return self._adopt(_bireg.fit(group.name, t, Y, w, self.solver, self.method,
+                                      float(self.tol),
+                                      _arrays.positive_int(self.max_iter, "max_iter"),
+                                      _arrays.positive_int(self.threads, "threads"),
+                                      "none" if self.loss is None else str(self.loss),
+                                      float(self.loss_scale)), stacklevel=3)
+
+    def _adopt(self, fit, stacklevel):
+        """Takes a fitted handle's results as this estimator's (fit, and
+        bireg.dask.fit); warns at the caller `stacklevel` frames up."""
+        self._fit = fit
         self.robust_ = fit.robust if self.loss is not None else None
         self.status_ = fit.status
         self.n_iter_ = fit.iterations
@@ -80,10 +85,10 @@ class GeodesicRegression:
             self.body_velocity_ = self.spatial_velocity_ = None
         if self.status_ not in _SUCCESS:
             warnings.warn(f"the fit stopped with status {self.status_} after {self.n_iter_} "
-                          "iterations", ConvergenceWarning, stacklevel=2)
+                          "iterations", ConvergenceWarning, stacklevel=stacklevel)
         elif self.robust_ is not None and self.robust_["status"] != "converged":
             warnings.warn(f"the robust reweighting stopped with status {self.robust_['status']}: "
-                          f"{self.robust_['message']}", ConvergenceWarning, stacklevel=2)
+                          f"{self.robust_['message']}", ConvergenceWarning, stacklevel=stacklevel)
         return self
 
     @property
@@ -91,6 +96,9 @@ class GeodesicRegression:
         """log(gamma(t_i)^-1 Y_i) of each observation at the fit, (N, d)."""
         if not hasattr(self, "_fit"):
             raise AttributeError("residuals_: this GeodesicRegression is not fitted yet")
+        if self._fit.chunked:
+            raise AttributeError("residuals_: a fit by bireg.dask.fit keeps its residuals with "
+                                 "the chunks")
         if self._residuals is None:
             self._residuals = self._fit.residuals
         return self._residuals
@@ -99,6 +107,14 @@ class GeodesicRegression:
         if not hasattr(self, "_fit"):
             raise ValueError("this GeodesicRegression is not fitted yet: call fit(t, Y) first")
         return self._fit
+
+    def _fitted_here(self, what):
+        """The fit, when its observations are in this process."""
+        fit = self._fitted()
+        if fit.chunked:
+            raise ValueError(f"{what} needs the observations in this process: a fit by "
+                             "bireg.dask.fit keeps them on the workers (fit locally for it)")
+        return fit
 
     def predict(self, t):
         """The fitted geodesic at t: (M,) -> (M, n, n)."""
@@ -120,18 +136,18 @@ class GeodesicRegression:
     def covariance(self, flavour="robust"):
         """Endpoint and velocity covariances (left-trivialised) and standard
         errors: a dict (bireg::covariance and velocity_covariance)."""
-        return _bireg.covariance(self._fitted(), flavour)
+        return _bireg.covariance(self._fitted_here("covariance"), flavour)
 
     def confidence_band(self, t, level=0.95, flavour="robust"):
         """Per covariate, the half-widths of the pose's confidence region
         along each body-frame coordinate: (M,) -> (M, d)."""
-        return _bireg.confidence_band(self._fitted(), _arrays.covariates(t), float(level),
+        return _bireg.confidence_band(self._fitted_here("confidence_band"), _arrays.covariates(t), float(level),
                                       flavour)
 
     def trend_test(self, permutations=999, seed=0, threads=1):
         """The permutation test of 'no trend' (Wilks' Lambda): a dict with
         statistic and p_value (bireg::trend_test)."""
-        return _bireg.trend_test(self._fitted(), _arrays.positive_int(permutations, "permutations"),
+        return _bireg.trend_test(self._fitted_here("trend_test"), _arrays.positive_int(permutations, "permutations"),
                                  _arrays.positive_int(seed, "seed"),
                                  _arrays.positive_int(threads, "threads"))
 

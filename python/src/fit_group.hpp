@@ -6,6 +6,8 @@
 
 #include "fit_handle.hpp"
 
+#include "bireg/regression/chunked_fit.hpp"
+
 namespace bireg_python {
 
 template <class G>
@@ -31,6 +33,67 @@ std::unique_ptr<FitHandle> GroupFitter<G>::fit(const FitRequest& request) {
   if (fit->robust && fit->robust->status == bireg::RobustStatus::invalid_input)
     refuse(fit->robust->message);
   return fit;
+}
+
+namespace chunk_numbers {
+
+// The record of numbers that a Python transport carried; ValueError when
+// their layout is not this module's (another bireg version wrote them).
+template <class Record>
+Record read(const double* numbers, std::size_t count, const char* what) {
+  auto record = bireg::from_numbers<Record>(numbers, count);
+  if (!record) {
+    refuse(std::string("the ") + what + " has " + std::to_string(count) +
+           " numbers, not this bireg version's layout (every worker needs the client's "
+           "version)");
+  }
+  return *record;
+}
+
+}  // namespace chunk_numbers
+
+template <class G>
+std::unique_ptr<FitHandle> GroupFitter<G>::fit_by_chunks(
+    const std::string& group, const nb::callable& reduce,
+    const bireg::RegressionOptions<double>& options) {
+  const auto reduce_chunks = [&](const bireg::ChunkRequest<G>& request) {
+    const nb::object parts = reduce(vector_array(bireg::to_numbers(request)));
+    bireg::ChunkSums<G> total;
+    for (nb::handle part : parts) {
+      const Vector numbers = nb::cast<Vector>(part);
+      total.add(chunk_numbers::read<bireg::ChunkSums<G>>(numbers.data(), numbers.shape(0),
+                                                         "chunk's sums"));
+    }
+    return total;
+  };
+  auto fit = std::make_unique<GroupFit<G>>();
+  fit->group = group;
+  fit->chunked = true;
+  fit->options = options;
+  fit->result = bireg::fit_by_chunks<G>(options, reduce_chunks);
+  if (fit->result.status == bireg::Status::invalid_input) refuse(fit->result.message);
+  return fit;
+}
+
+template <class G>
+Output GroupFitter<G>::chunk_sums(const Vector& request, const Vector& t, const Stack& y,
+                                  const Vector& w, std::size_t offset) {
+  const auto parsed =
+      chunk_numbers::read<bireg::ChunkRequest<G>>(request.data(), request.shape(0), "request");
+  if (t.shape(0) != y.shape(0) || (w.shape(0) != 0 && w.shape(0) != y.shape(0))) {
+    refuse("a chunk's covariates, poses and weights differ in length (" +
+           std::to_string(t.shape(0)) + ", " + std::to_string(y.shape(0)) + ", " +
+           std::to_string(w.shape(0)) + ")");
+  }
+  std::vector<double> numbers;
+  {
+    nb::gil_scoped_release release;
+    const std::vector<double> covariates = to_vector(t), weights = to_vector(w);
+    const bireg::ChunkSums<G> sums =
+        bireg::chunk_sums<G>(parsed, StackView<G>(y), covariates, weights, offset);
+    numbers = bireg::to_numbers(sums);
+  }
+  return vector_array(numbers);
 }
 
 }  // namespace bireg_python

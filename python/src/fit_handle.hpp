@@ -21,6 +21,9 @@ namespace bireg_python {
 struct FitHandle {
   virtual ~FitHandle() = default;
   std::string group;
+  // Fitted by chunks elsewhere (fit_by_chunks): the observations and the
+  // residuals are not here.
+  bool chunked = false;
 };
 
 template <class G>
@@ -36,6 +39,15 @@ struct GroupFit final : FitHandle {
   std::optional<bireg::RobustResult<G>> robust;
 
   StackView<G> observations() const { return StackView<G>(poses); }
+
+  // ValueError naming `what` for a chunked fit, which has neither the
+  // observations nor the residuals here (call with the GIL held).
+  void require_observations(const char* what) const {
+    if (chunked) {
+      refuse(std::string(what) +
+             ": this fit's observations are with its chunks (bireg.dask.fit), not here");
+    }
+  }
 };
 
 // What fit() was asked, checked: the data Python holds and the options.
@@ -60,6 +72,20 @@ struct FitRequest {
 template <class G>
 struct GroupFitter {
   static std::unique_ptr<FitHandle> fit(const FitRequest& request);
+
+  // bireg::fit_by_chunks (regression/chunked_fit.hpp) with a Python
+  // transport: reduce(request) takes a request's numbers and returns a
+  // list of every chunk's sums' numbers (chunk_sums below, on the
+  // workers), in chunk order; they are joined here in that order. The
+  // handle has the fit and no observations.
+  static std::unique_ptr<FitHandle> fit_by_chunks(const std::string& group,
+                                                  const nb::callable& reduce,
+                                                  const bireg::RegressionOptions<double>& options);
+  // bireg::chunk_sums of one chunk (y[i] at t[i] with weights w, empty: all
+  // 1, the whole set's observation offset + i), the GIL released: the
+  // request's numbers in, the sums' numbers out.
+  static Output chunk_sums(const Vector& request, const Vector& t, const Stack& y, const Vector& w,
+                           std::size_t offset);
 };
 
 // The handle as the group's fit; the group is the handle's own.

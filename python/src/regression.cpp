@@ -150,6 +150,7 @@ void bind_regression(nb::module_& m) {
   nb::class_<FitHandle>(m, "FitHandle",
                         "A geodesic fitted by bireg::GeodesicRegression, with its data.")
       .def_ro("group", &FitHandle::group)
+      .def_ro("chunked", &FitHandle::chunked)
       .def_prop_ro("status",
                    [](const FitHandle& h) {
                      return on_fit(
@@ -251,6 +252,34 @@ void bind_regression(nb::module_& m) {
       nb::arg("loss_scale"),
       "bireg::GeodesicRegression<G>::fit (or RobustGeodesicRegression with a loss) of y at t "
       "with weights (empty: all 1). ValueError for invalid input.");
+
+  m.def(
+      "fit_by_chunks",
+      [](const std::string& group, const nb::callable& reduce, const std::string& solver,
+         const std::string& method, double tolerance, int max_iterations) {
+        const bireg::RegressionOptions<double> options =
+            regression_options(solver, method, tolerance, max_iterations, 1);
+        return with_group(group, [&](auto tag) {
+          return GroupFitter<typename decltype(tag)::type>::fit_by_chunks(group, reduce, options);
+        });
+      },
+      nb::arg("group"), nb::arg("reduce"), nb::arg("solver"), nb::arg("method"), nb::arg("tol"),
+      nb::arg("max_iter"),
+      "bireg::fit_by_chunks<G>: fit()'s steps on observations held in chunks elsewhere. "
+      "reduce(request) gets a request's numbers and returns every chunk's chunk_sums numbers, "
+      "in chunk order. ValueError for invalid input; what reduce raises passes through.");
+  m.def(
+      "chunk_sums",
+      [](const std::string& group, const Vector& request, const Vector& t, const Stack& y,
+         const Vector& w, std::size_t offset) {
+        return with_group(group, [&](auto tag) {
+          return GroupFitter<typename decltype(tag)::type>::chunk_sums(request, t, y, w, offset);
+        });
+      },
+      nb::arg("group"), nb::arg("request"), nb::arg("t"), nb::arg("y"), nb::arg("weights"),
+      nb::arg("offset"),
+      "bireg::chunk_sums<G> of one chunk (observation i is the whole set's offset + i), "
+      "request and sums as numbers. The GIL is released.");
 }
 
 }  // namespace bireg_python

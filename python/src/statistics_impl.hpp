@@ -63,6 +63,7 @@ inline bireg::CovarianceFlavour flavour_of(const std::string& name) {
 
 template <class G>
 bireg::FitCovariance<G> covariance_of(const GroupFit<G>& fit, bireg::CovarianceFlavour flavour) {
+  fit.require_observations("covariance");
   bireg::FitCovariance<G> c;
   {
     nb::gil_scoped_release release;
@@ -140,6 +141,7 @@ double score(const GroupFit<G>& fit, const Vector& t, const Stack& y) {
 
 template <class G>
 nb::dict trend_test(const GroupFit<G>& fit, int permutations, std::uint64_t seed, int threads) {
+  fit.require_observations("trend_test");
   if (fit.robust)
     refuse(
         "trend_test: not available for a robust fit (the permuted fits would need the "

@@ -215,26 +215,121 @@ def test_bad_data_are_refused_with_the_local_index(client, rng):
         bireg.dask.two_sample_test(A, B, group="SO3", permutations=9, client=client, blocks=0)
 
 
-@pytest.mark.parametrize("kind", ["relabellings", "map"])
+# 1e5 SE(3) poses about a geodesic, in 7 chunks of unequal size.
+_CHUNKS = (1, 17000, 9999, 30000, 2, 23456, 19542)
+
+
+def poses(rng, count):
+    g = bireg.SE3
+    t = rng.uniform(0, 10, count)
+    start = g.exp(rng.standard_normal(6))
+    velocity = 0.1 * rng.standard_normal(6)
+    Y = g.compose(start, g.exp(t[:, None] * velocity + 0.05 * rng.standard_normal((count, 6))))
+    return t, Y
+
+
+def chunked(t, Y, w=None):
+    import dask.array as da
+
+    out = (da.from_array(t, chunks=(_CHUNKS,)), da.from_array(Y, chunks=(_CHUNKS, 4, 4)))
+    return out + (None if w is None else da.from_array(w, chunks=(_CHUNKS,)),)
+
+
+def assert_close_fits(chunked_fit, local):
+    assert chunked_fit.status_ == local.status_
+    assert chunked_fit.n_iter_ == local.n_iter_
+    assert chunked_fit.interval_ == local.interval_
+    for name in ("g0_", "g1_", "body_velocity_"):
+        a, b = getattr(chunked_fit, name), getattr(local, name)
+        assert np.linalg.norm(a - b) <= 1e-12 * max(1.0, np.linalg.norm(b)), name
+    for name in ("residual_rms", "residual_rms_about_mean", "mu_min"):
+        a, b = chunked_fit.diagnostics_[name], local.diagnostics_[name]
+        assert abs(a - b) <= 1e-12 * abs(b), name
+    # The force at the estimate is what rounding leaves of a sum of N terms
+    # of about the residuals' size: two summation orders differ by about
+    # eps N rms (2.7e-12 here), not relative to the force itself.
+    n = sum(_CHUNKS)
+    scale = np.finfo(float).eps * n * local.diagnostics_["residual_rms"]
+    assert (abs(chunked_fit.diagnostics_["force_norm"] - local.diagnostics_["force_norm"])
+            <= 16 * scale)
+    assert (chunked_fit.diagnostics_["largest_residual_observation"]
+            == local.diagnostics_["largest_residual_observation"])
+
+
+def test_one_fit_over_unequal_chunks_is_the_local_fit(client, rng):
+    """bireg.dask.fit of 1e5 poses in 7 unequal chunks: the local fit to
+    1e-12 relative (only the summation order differs), with and without
+    weights, from Dask or numpy arrays."""
+    t, Y = poses(rng, sum(_CHUNKS))
+    w = rng.uniform(0.5, 2.0, t.size)
+    local = bireg.GeodesicRegression(group="SE3").fit(t, Y)
+    assert local.status_ == "converged"
+    assert_close_fits(bireg.dask.fit(*chunked(t, Y)[:2], group="SE3", client=client), local)
+    weighted = bireg.GeodesicRegression(group="SE3").fit(t, Y, sample_weight=w)
+    t_da, Y_da, w_da = chunked(t, Y, w)
+    assert_close_fits(bireg.dask.fit(t_da, Y_da, group="SE3", sample_weight=w_da, client=client),
+                      weighted)
+    from_numpy = bireg.dask.fit(t, Y, group="SE3", sample_weight=w, client=client,
+                                chunk_size=30001)
+    assert_close_fits(from_numpy, weighted)
+    # A chunked fit has no residuals, covariance or band here.
+    with pytest.raises(AttributeError, match="residuals"):
+        from_numpy.residuals_
+    with pytest.raises(ValueError, match="observations in this process"):
+        from_numpy.covariance()
+    np.testing.assert_allclose(from_numpy.predict(t[:5]), weighted.predict(t[:5]), rtol=0,
+                               atol=1e-12)
+
+
+def test_a_chunked_fit_refuses_bad_data_with_the_global_index(client, rng):
+    t, Y = poses(rng, sum(_CHUNKS))
+    Y[60000, 1, 3] = np.nan  # in the fifth chunk
+    Y[90000, 0, 0] = 2.0     # a later non-element: the first is named
+    with pytest.raises(ValueError, match="observation 60000 has non-finite entries"):
+        bireg.GeodesicRegression(group="SE3").fit(t, Y)
+    with pytest.raises(ValueError, match="^observation 60000 has non-finite entries$"):
+        bireg.dask.fit(*chunked(t, Y)[:2], group="SE3", client=client)
+    t[7] = np.inf
+    with pytest.raises(ValueError, match="^covariate 7 is not finite$"):
+        bireg.dask.fit(*chunked(t, Y)[:2], group="SE3", client=client)
+    with pytest.raises(ValueError, match=r"Y must have shape \(N, 3, 3\)"):
+        bireg.dask.fit(t, Y, group="SO3", client=client)
+    with pytest.raises(ValueError, match="t must have shape"):
+        bireg.dask.fit(t[:-1], Y, group="SE3", client=client)
+    with pytest.raises(ValueError, match="unknown solver"):
+        bireg.dask.fit(t, Y, group="SE3", solver="newton", client=client)
+
+
+@pytest.mark.parametrize("kind", ["relabellings", "map", "fit"])
 def test_a_worker_killed_mid_test_changes_nothing(client, rng, kind):
     """Runs last: the cluster then has new workers in place of the killed ones."""
     if kind == "relabellings":
         a = rotations(rng, 40, np.eye(3))
         b = rotations(rng, 40, bireg.SO3.exp(np.array([0.05, 0.0, 0.0])))
         arguments = dict(group="SO3", permutations=30000, seed=5)
-    else:  # slices of elements, each sent inside its own task
+    elif kind == "map":  # slices of elements, each sent inside its own task
         a = rotations(rng, 30 * 12, np.eye(3)).reshape(30, 12, 3, 3)
         b = rotations(rng, 30 * 12, np.eye(3)).reshape(30, 12, 3, 3)
         arguments = dict(group="SO3", permutations=3000, seed=5, mode="exact")
-    local = bireg.two_sample_test(a, b, **arguments)
+    if kind == "fit":  # one fit, its chunks persisted on the workers
+        t, Y = poses(rng, 400000)
+
+        def run():
+            return bireg.dask.fit(t, Y, group="SE3", client=client, chunk_size=20000)
+
+        local = run()  # undisturbed: the same chunks, joined in the same order
+    else:
+        local = bireg.two_sample_test(a, b, **arguments)
+
+        def run():
+            return bireg.dask.two_sample_test(a, b, client=client, blocks=12, **arguments)
     client.wait_for_workers(3, timeout=60)
     victim = sorted(client.scheduler_info()["workers"])[0]
     pid = client.run(os.getpid, workers=[victim])[victim]
     outcome = {}
 
     def spread():
-        outcome["result"] = bireg.dask.two_sample_test(a, b, client=client, blocks=12,
-                                                       **arguments)
+        outcome["result"] = run()
 
     thread = threading.Thread(target=spread)
     thread.start()
@@ -250,4 +345,10 @@ def test_a_worker_killed_mid_test_changes_nothing(client, rng, kind):
     os.kill(pid, signal.SIGKILL)
     thread.join(timeout=180)
     assert not thread.is_alive()
-    same(outcome["result"], local)
+    if kind == "fit":  # bit for bit: the same chunks' sums, joined in the same order
+        result = outcome["result"]
+        assert np.array_equal(result.g0_, local.g0_) and np.array_equal(result.g1_, local.g1_)
+        assert ((result.status_, result.n_iter_, result.diagnostics_)
+                == (local.status_, local.n_iter_, local.diagnostics_))
+    else:
+        same(outcome["result"], local)

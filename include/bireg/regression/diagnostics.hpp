@@ -71,11 +71,57 @@ struct RegressionDiagnostics {
 template <class Scalar>
 constexpr Scalar kBeyondDomainAngle = Scalar(0.75L * 3.14159265358979323846264338327950288L);
 
+// sum w |r_i|^2 and the largest residual angle with its observation (the
+// smallest index of equals) over residuals [begin, end), named i + offset;
+// and the first residual that is not finite. `add` joins two chunks' sums
+// in either order. problem.w[i] belongs to residual i.
+template <class G>
+struct ResidualSums {
+  using Scalar = typename G::Scalar;
+  Scalar residual_sum = 0;
+  Scalar largest_angle = 0;
+  std::ptrdiff_t largest_observation = -1;
+  std::ptrdiff_t not_finite = -1;
+
+  static ResidualSums over(const Problem<Scalar>& problem,
+                           const std::vector<typename G::Tangent>& residuals, std::size_t begin,
+                           std::size_t end, std::size_t offset = 0) {
+    ResidualSums sums;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Scalar w = problem.w[i];
+      if (sums.not_finite < 0 && !residuals[i].allFinite())
+        sums.not_finite = static_cast<std::ptrdiff_t>(i + offset);
+      sums.residual_sum += w * residuals[i].squaredNorm();
+      if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
+        if (w == 0) continue;  // a zero weight takes the observation out of the fit
+        const Scalar angle = G::ad_spectral_radius(residuals[i]);
+        if (angle > sums.largest_angle) {
+          sums.largest_angle = angle;
+          sums.largest_observation = static_cast<std::ptrdiff_t>(i + offset);
+        }
+      }
+    }
+    return sums;
+  }
+
+  void add(const ResidualSums& other) {
+    residual_sum += other.residual_sum;
+    if (other.largest_angle > largest_angle ||
+        (other.largest_angle == largest_angle && other.largest_observation >= 0 &&
+         (largest_observation < 0 || other.largest_observation < largest_observation))) {
+      largest_angle = other.largest_angle;
+      largest_observation = other.largest_observation;
+    }
+    if (other.not_finite >= 0 && (not_finite < 0 || other.not_finite < not_finite))
+      not_finite = other.not_finite;
+  }
+};
+
+// The diagnostics from the residuals' sums over all observations.
 template <class G, class Rule>
-RegressionDiagnostics<typename G::Scalar> diagnose(
+RegressionDiagnostics<typename G::Scalar> diagnose_from_sums(
     const Problem<typename G::Scalar>& problem, const Rule& rule, const IterationRecord<G>& record,
-    const State<G>& state, typename G::Scalar spread,
-    const std::vector<typename G::Tangent>& residuals, ChunkPool* pool = nullptr) {
+    const State<G>& state, typename G::Scalar spread, const ResidualSums<G>& sums) {
   using Scalar = typename G::Scalar;
   using std::sqrt;
   RegressionDiagnostics<Scalar> d;
@@ -91,37 +137,6 @@ RegressionDiagnostics<typename G::Scalar> diagnose(
   if (steps >= 2 && record.step_norms[steps - 2] > 0) {
     d.contraction_factor = record.step_norms[steps - 1] / record.step_norms[steps - 2];
   }
-  // sum w |r_i|^2 and the largest residual angle (the first observation of
-  // equals), by chunks on `pool` when one is given.
-  struct Sums {
-    Scalar residual_sum = 0;
-    Scalar largest_angle = 0;
-    std::ptrdiff_t largest_observation = -1;
-  };
-  const Sums sums = reduce_chunks<Sums>(
-      residuals.size(), pool,
-      [&](std::size_t begin, std::size_t end) {
-        Sums chunk;
-        for (std::size_t i = begin; i < end; ++i) {
-          chunk.residual_sum += problem.w[i] * residuals[i].squaredNorm();
-          if constexpr (provides_v<G, capability_detail::ad_spectral_radius>) {
-            if (problem.w[i] == 0) continue;  // a zero weight takes the observation out of the fit
-            const Scalar angle = G::ad_spectral_radius(residuals[i]);
-            if (angle > chunk.largest_angle) {
-              chunk.largest_angle = angle;
-              chunk.largest_observation = static_cast<std::ptrdiff_t>(i);
-            }
-          }
-        }
-        return chunk;
-      },
-      [](Sums& total, const Sums& next) {
-        total.residual_sum += next.residual_sum;
-        if (next.largest_angle > total.largest_angle) {
-          total.largest_angle = next.largest_angle;
-          total.largest_observation = next.largest_observation;
-        }
-      });
   const Scalar residual_sum = sums.residual_sum;
   d.residual_rms = sqrt(residual_sum / problem.weight_sum);
   d.residual_rms_about_mean = sqrt(spread / problem.weight_sum);
@@ -132,6 +147,22 @@ RegressionDiagnostics<typename G::Scalar> diagnose(
     d.beyond_domain = d.largest_residual_angle > kBeyondDomainAngle<Scalar>;
   }
   return d;
+}
+
+// The diagnostics of a fit whose residuals are all here, by chunks on
+// `pool` when one is given.
+template <class G, class Rule>
+RegressionDiagnostics<typename G::Scalar> diagnose(
+    const Problem<typename G::Scalar>& problem, const Rule& rule, const IterationRecord<G>& record,
+    const State<G>& state, typename G::Scalar spread,
+    const std::vector<typename G::Tangent>& residuals, ChunkPool* pool = nullptr) {
+  const ResidualSums<G> sums = reduce_chunks<ResidualSums<G>>(
+      residuals.size(), pool,
+      [&](std::size_t begin, std::size_t end) {
+        return ResidualSums<G>::over(problem, residuals, begin, end);
+      },
+      [](ResidualSums<G>& total, const ResidualSums<G>& next) { total.add(next); });
+  return diagnose_from_sums<G>(problem, rule, record, state, spread, sums);
 }
 
 }  // namespace bireg

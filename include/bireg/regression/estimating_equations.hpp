@@ -278,14 +278,14 @@ Force<G> closed_form_force(const Observations& observations,
 
 }  // namespace estimating_detail
 
-// Evaluates x, ad_x, the series order and the force at (g0, g1), writing
-// the residuals there into `residuals` (sized N). Outside the series' disc
-// (spectral radius of ad_x at or above 2 pi) only x and ad_x are set.
-template <class G, class Observations>
-State<G> evaluate(const Observations& observations, const Problem<typename G::Scalar>& problem,
-                  const PsiEvaluation& psi, const typename G::Element& g0,
-                  const typename G::Element& g1, std::vector<typename G::Tangent>& residuals,
-                  ForceWorkspace<G>* workspace = nullptr) {
+// The state at (g0, g1) without its force: x, ad_x, whether the series
+// converges and, where the force is evaluated by the series, its order.
+// closed_form says the force is evaluated in G's closed form. Every
+// evaluation of the force starts here, so sums over separate chunks of
+// the observations (chunked_fit.hpp) are made with the same choices.
+template <class G>
+State<G> prepare_state(const PsiEvaluation& psi, const typename G::Element& g0,
+                       const typename G::Element& g1, bool& closed_form) {
   using Scalar = typename G::Scalar;
   constexpr Scalar kTwoPi = Scalar(6.283185307179586476925286766559L);
   State<G> state;
@@ -293,14 +293,14 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
   state.g1 = g1;
   state.x = log_at<G>(g0, g1);
   state.a = G::ad(state.x);
+  closed_form = false;
   if (!(ad_spectral_radius<G>(state.x) < kTwoPi)) {
     state.series_converges = false;
     return state;
   }
   if constexpr (has_closed_form_psi_v<G>) {
     if (psi.method == Method::exact && uses_closed_form_psi<G>(state.x)) {
-      state.force = estimating_detail::closed_form_force<G>(observations, problem, g0, state.x,
-                                                            residuals, workspace);
+      closed_form = true;
       return state;
     }
   }
@@ -309,6 +309,27 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
   } else {
     std::tie(state.order, state.truncation) = adaptive_series_order(
         state.a, std::numeric_limits<Scalar>::epsilon(), psi.max_series_order);
+  }
+  return state;
+}
+
+// Evaluates x, ad_x, the series order and the force at (g0, g1), writing
+// the residuals there into `residuals` (sized N). Outside the series' disc
+// (spectral radius of ad_x at or above 2 pi) only x and ad_x are set.
+template <class G, class Observations>
+State<G> evaluate(const Observations& observations, const Problem<typename G::Scalar>& problem,
+                  const PsiEvaluation& psi, const typename G::Element& g0,
+                  const typename G::Element& g1, std::vector<typename G::Tangent>& residuals,
+                  ForceWorkspace<G>* workspace = nullptr) {
+  bool closed_form = false;
+  State<G> state = prepare_state<G>(psi, g0, g1, closed_form);
+  if (!state.series_converges) return state;
+  if constexpr (has_closed_form_psi_v<G>) {
+    if (closed_form) {
+      state.force = estimating_detail::closed_form_force<G>(observations, problem, g0, state.x,
+                                                            residuals, workspace);
+      return state;
+    }
   }
   state.force = estimating_detail::series_force<G>(observations, problem, g0, state.x, state.a,
                                                    state.order, residuals, workspace);

@@ -142,6 +142,10 @@ class DecisionRef {
 // workspace) can serve a sequence of fits without allocating again. Every state it returns has
 // a convergent series and a finite force, hence finite residuals, except
 // when even the fallback start (X = 0) is unusable, which cannot happen.
+// Each evaluation is evaluate<G>(observations, ...), found by
+// argument-dependent lookup: observations of a type with its own evaluate
+// (ChunkedObservations, chunked_fit.hpp: sums computed where the chunks
+// are) run this same iteration.
 template <class G, class Rule, class Observations>
 State<G> iterate(const Observations& observations, const Problem<typename G::Scalar>& problem,
                  const PsiEvaluation& psi, const Rule& rule,

@@ -26,6 +26,8 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
+#include <string>
 #include <utility>
 
 #include "bireg/geodesic.hpp"
@@ -64,6 +66,41 @@ std::size_t middle_observation(const Problem<Scalar>& problem) {
   return middle;
 }
 
+// The same over chunks of a larger set (chunked_fit.hpp): a chunk's
+// observation nearest the middle, named i + offset, and the observation
+// itself; `add` keeps the nearer (the smaller index of equals), in either
+// order. problem.t[i] belongs to observation i.
+template <class G>
+struct MiddleCandidate {
+  using Scalar = typename G::Scalar;
+  std::ptrdiff_t index = -1;
+  Scalar distance = std::numeric_limits<Scalar>::infinity();
+  typename G::Element element = G::identity();
+
+  template <class Observations>
+  static MiddleCandidate over(const Observations& observations, const Problem<Scalar>& problem,
+                              std::size_t begin, std::size_t end, std::size_t offset = 0) {
+    using std::abs;
+    MiddleCandidate middle;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Scalar distance = abs(problem.t[i] - Scalar(0.5));
+      if (distance < middle.distance) {
+        middle.distance = distance;
+        middle.index = static_cast<std::ptrdiff_t>(i + offset);
+      }
+    }
+    if (middle.index >= 0) middle.element = observations[std::size_t(middle.index) - offset];
+    return middle;
+  }
+  void add(const MiddleCandidate& other) {
+    if (other.index < 0) return;
+    if (index < 0 || other.distance < distance ||
+        (other.distance == distance && other.index < index)) {
+      *this = other;
+    }
+  }
+};
+
 // The weighted least-squares line y_i ~ (1 - t_i) x0 + t_i x1 from its
 // moments, moment0 = sum w (1 - t) y and moment1 = sum w t y:
 // (x0, x1) = (H^{-1} kron I)(moment0, moment1).
@@ -75,64 +112,126 @@ std::pair<Tangent, Tangent> least_squares_line(const Problem<Scalar>& problem,
           (problem.a * moment1 - problem.b * moment0) / determinant};
 }
 
+// The chart's sums over observations [begin, end) at f_ref:
+// sum w (1 - t) y, sum w t y and sum w |y|^2 with y_i = log(f_ref^{-1} f_i),
+// or the first observation (index i + offset) whose y_i is not finite or
+// too large, where the pass stops. `add` joins two chunks' sums in either
+// order (the smaller index wins). problem.t[i] and
+// problem.w[i] belong to observation i.
+template <class G>
+struct ChartSums {
+  using Scalar = typename G::Scalar;
+  using Tangent = typename G::Tangent;
+  Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
+  Scalar square_sum = 0;
+  std::ptrdiff_t outside_index = -1;  // the first observation without a usable y_i
+  bool outside_finite = false;        // its y_i is finite (too large) or not (no logarithm)
+
+  bool outside() const { return outside_index >= 0; }
+
+  template <class Observations>
+  static ChartSums over(const Observations& observations, const Problem<Scalar>& problem,
+                        const typename G::Element& f_ref_inverse, std::size_t begin,
+                        std::size_t end, std::size_t offset = 0) {
+    ChartSums sums;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
+      const bool finite = y.allFinite();
+      if (!finite || y.cwiseAbs().maxCoeff() > largest_tangent<Scalar>()) {
+        sums.outside_index = static_cast<std::ptrdiff_t>(i + offset);
+        sums.outside_finite = finite;
+        return sums;
+      }
+      const Scalar t = problem.t[i], w = problem.w[i];
+      sums.moment0 += w * (1 - t) * y;
+      sums.moment1 += w * t * y;
+      sums.square_sum += w * y.squaredNorm();
+    }
+    return sums;
+  }
+
+  void add(const ChartSums& other) {
+    if (outside() || other.outside()) {
+      if (other.outside() && (!outside() || other.outside_index < outside_index)) *this = other;
+      return;
+    }
+    moment0 += other.moment0;
+    moment1 += other.moment1;
+    square_sum += other.square_sum;
+  }
+};
+
+// The start from the chart's sums over all observations at f_ref.
+template <class G>
+ChartStart<G> chart_from_sums(const typename G::Element& f_ref,
+                              const Problem<typename G::Scalar>& problem,
+                              const ChartSums<G>& sums) {
+  using Scalar = typename G::Scalar;
+  ChartStart<G> chart;
+  chart.reference = f_ref;
+  if (sums.outside()) {
+    chart.g0 = chart.g1 = f_ref;
+    (sums.outside_finite ? chart.too_large : chart.no_logarithm) = sums.outside_index;
+    return chart;
+  }
+  const auto [x0, x1] = least_squares_line(problem, sums.moment0, sums.moment1);
+  const typename G::Tangent total = sums.moment0 + sums.moment1;  // sum w y
+  chart.g0 = exp_at<G>(f_ref, x0);
+  chart.g1 = exp_at<G>(f_ref, x1);
+  chart.spread = std::max(Scalar(0), sums.square_sum - total.squaredNorm() / problem.weight_sum);
+  return chart;
+}
+
 // By chunks on `pool` when one is given (parallel.hpp: the same sums for
 // any thread count).
 template <class G, class Observations>
 ChartStart<G> chart_start(const Observations& observations,
                           const Problem<typename G::Scalar>& problem, ChunkPool* pool = nullptr) {
-  using Scalar = typename G::Scalar;
-  using Tangent = typename G::Tangent;
   const typename G::Element& f_ref = observations[middle_observation(problem)];
   const typename G::Element f_ref_inverse = G::inverse(f_ref);
-  // sum w (1 - t) y, sum w t y and sum w |y|^2 over a chunk, or the first
-  // observation of the chunk whose y_i is not finite or too large.
-  struct Sums {
-    Tangent moment0 = Tangent::Zero(), moment1 = Tangent::Zero();
-    Scalar square_sum = 0;
-    std::ptrdiff_t no_logarithm = -1, too_large = -1;
-    bool outside() const { return no_logarithm >= 0 || too_large >= 0; }
-  };
-  const Sums sums = reduce_chunks<Sums>(
+  const ChartSums<G> sums = reduce_chunks<ChartSums<G>>(
       observations.size(), pool,
       [&](std::size_t begin, std::size_t end) {
-        Sums chunk;
-        for (std::size_t i = begin; i < end; ++i) {
-          const Tangent y = G::log(G::compose(f_ref_inverse, observations[i]));
-          const bool finite = y.allFinite();
-          if (!finite || y.cwiseAbs().maxCoeff() > largest_tangent<Scalar>()) {
-            (finite ? chunk.too_large : chunk.no_logarithm) = static_cast<std::ptrdiff_t>(i);
-            return chunk;
-          }
-          chunk.moment0 += problem.w[i] * (1 - problem.t[i]) * y;
-          chunk.moment1 += problem.w[i] * problem.t[i] * y;
-          chunk.square_sum += problem.w[i] * y.squaredNorm();
-        }
-        return chunk;
+        return ChartSums<G>::over(observations, problem, f_ref_inverse, begin, end);
       },
-      [](Sums& total, const Sums& next) {
-        if (total.outside()) return;  // the first such observation is the one reported
-        if (next.outside()) {
-          total = next;
-          return;
-        }
-        total.moment0 += next.moment0;
-        total.moment1 += next.moment1;
-        total.square_sum += next.square_sum;
-      });
-  ChartStart<G> chart;
-  chart.reference = f_ref;
-  if (sums.outside()) {
-    chart.g0 = chart.g1 = f_ref;
-    chart.no_logarithm = sums.no_logarithm;
-    chart.too_large = sums.too_large;
-    return chart;
+      [](ChartSums<G>& total, const ChartSums<G>& next) { total.add(next); });
+  return chart_from_sums<G>(f_ref, problem, sums);
+}
+
+// Why the chart refuses the data, or nothing: an observation with no
+// logarithm from the middle one, or one too far from it.
+template <class G>
+std::optional<Rejection> chart_rejection(const ChartStart<G>& chart) {
+  if (chart.no_logarithm >= 0) {
+    return Rejection{"observation " + std::to_string(chart.no_logarithm) +
+                         " is out of reach of the middle observation: no principal logarithm "
+                         "of f_mid^{-1} f_i (the data leave the domain of " +
+                         G::name + "'s log)",
+                     chart.no_logarithm};
   }
-  const auto [x0, x1] = least_squares_line(problem, sums.moment0, sums.moment1);
-  const Tangent total = sums.moment0 + sums.moment1;  // sum w y
-  chart.g0 = exp_at<G>(f_ref, x0);
-  chart.g1 = exp_at<G>(f_ref, x1);
-  chart.spread = std::max(Scalar(0), sums.square_sum - total.squaredNorm() / problem.weight_sum);
-  return chart;
+  if (chart.too_large >= 0) {
+    return Rejection{"observation " + std::to_string(chart.too_large) +
+                         " lies too far from the middle observation: log(f_mid^{-1} f_i) has "
+                         "coordinates above " +
+                         std::to_string(double(largest_tangent<typename G::Scalar>())) +
+                         ", whose squares the fit cannot sum in this scalar type",
+                     chart.too_large};
+  }
+  return std::nullopt;
+}
+
+// The refusal of a start whose estimating equations are not finite,
+// naming the first observation whose residual there is not (-1: none).
+template <class G>
+Rejection unevaluable_start(std::ptrdiff_t first_bad) {
+  const std::string which = first_bad >= 0
+                                ? "the residual of observation " + std::to_string(first_bad)
+                                : std::string("the estimating equations");
+  return {which +
+              " is not finite at the start: the data span magnitudes that this scalar type "
+              "cannot invert and take the log of in " +
+              G::name,
+          first_bad};
 }
 
 }  // namespace bireg

@@ -45,6 +45,42 @@ namespace bireg {
 // and nothing else; at spectral radius 1 they are below (1/(2 pi))^16 ~ 6e-14.
 inline constexpr int kGaussNewtonOrder = 16;
 
+// The mixed moments S[p][q] = sum_i w_i t_i^p u_i^q (u = 1 - t), p, q >= 1,
+// p + q <= kGaussNewtonOrder + 2, of a problem's observations: what K's
+// off-diagonal blocks are built from. `add` joins two chunks' moments.
+template <class Scalar>
+struct GaussNewtonMoments {
+  static constexpr int kMaxPowers = kGaussNewtonOrder + 2;
+  std::array<std::array<Scalar, kMaxPowers + 1>, kMaxPowers + 1> s{};
+
+  // Over observations [begin, end) of `problem`, to total power `powers`.
+  static GaussNewtonMoments over(const Problem<Scalar>& problem, std::size_t begin, std::size_t end,
+                                 int powers = kMaxPowers) {
+    GaussNewtonMoments chunk;
+    std::array<Scalar, kMaxPowers + 1> t_power{}, u_power{};
+    for (std::size_t i = begin; i < end; ++i) {
+      const Scalar t = problem.t[i], u = 1 - t;
+      t_power[0] = problem.w[i];
+      u_power[0] = 1;
+      for (int j = 1; j <= powers; ++j) {
+        t_power[j] = t_power[j - 1] * t;
+        u_power[j] = u_power[j - 1] * u;
+      }
+      for (int p = 1; p < powers; ++p) {
+        for (int q = 1; p + q <= powers; ++q)
+          chunk.s[p][q] += t_power[p] * u_power[q];
+      }
+    }
+    return chunk;
+  }
+  void add(const GaussNewtonMoments& other, int powers = kMaxPowers) {
+    for (int p = 1; p < powers; ++p) {
+      for (int q = 1; p + q <= powers; ++q)
+        s[p][q] += other.s[p][q];
+    }
+  }
+};
+
 template <class G>
 class GaussNewtonStep {
  public:
@@ -71,44 +107,21 @@ class GaussNewtonStep {
   // the same sums for any thread count).
   GaussNewtonStep(const Problem<Scalar>& problem, Scalar, int order = kGaussNewtonOrder,
                   ChunkPool* pool = nullptr)
+      : GaussNewtonStep(problem, moments(problem, std::clamp(order, 0, kGaussNewtonOrder), pool),
+                        order) {}
+
+  // From the moments of all observations (GaussNewtonMoments, summed over
+  // chunks elsewhere: chunked_fit.hpp), to total power order + 2 at least.
+  GaussNewtonStep(const Problem<Scalar>& problem, const GaussNewtonMoments<Scalar>& moments,
+                  int order = kGaussNewtonOrder)
       : a_(problem.a), c_(problem.c), order_(std::clamp(order, 0, kGaussNewtonOrder)) {
-    constexpr int kMaxPowers = kGaussNewtonOrder + 2;
-    const int powers = order_ + 2;
-    using Moments = std::array<std::array<Scalar, kMaxPowers + 1>, kMaxPowers + 1>;
-    using Powers = std::array<Scalar, kMaxPowers + 1>;
-    const Moments moments = reduce_chunks<Moments>(
-        problem.size(), pool,
-        [&](std::size_t begin, std::size_t end) {
-          Moments chunk{};
-          Powers t_power{}, u_power{};
-          for (std::size_t i = begin; i < end; ++i) {
-            const Scalar t = problem.t[i], u = 1 - t;
-            t_power[0] = problem.w[i];
-            u_power[0] = 1;
-            for (int j = 1; j <= powers; ++j) {
-              t_power[j] = t_power[j - 1] * t;
-              u_power[j] = u_power[j - 1] * u;
-            }
-            for (int p = 1; p < powers; ++p) {
-              for (int q = 1; p + q <= powers; ++q)
-                chunk[p][q] += t_power[p] * u_power[q];
-            }
-          }
-          return chunk;
-        },
-        [powers](Moments& total, const Moments& next) {
-          for (int p = 1; p < powers; ++p) {
-            for (int q = 1; p + q <= powers; ++q)
-              total[p][q] += next[p][q];
-          }
-        });
     for (int m = 0; m <= order_; ++m) {
       Scalar start = 0, end = 0;
       for (int k = 0; k <= m; ++k) {
         const Scalar coefficient = static_cast<Scalar>(kPsiSeriesTable[m][k]);
         const Scalar signed_coefficient = k % 2 == 0 ? coefficient : -coefficient;
-        start += signed_coefficient * moments[m - k + 1][k + 1];
-        end += signed_coefficient * moments[k + 1][m - k + 1];
+        start += signed_coefficient * moments.s[m - k + 1][k + 1];
+        end += signed_coefficient * moments.s[k + 1][m - k + 1];
       }
       k01_[m] = start;
       k10_[m] = m % 2 == 0 ? end : -end;
@@ -145,6 +158,19 @@ class GaussNewtonStep {
   Scalar convergence_norm(Scalar step_norm, const State<G>&) const { return step_norm; }
 
  private:
+  static GaussNewtonMoments<Scalar> moments(const Problem<Scalar>& problem, int order,
+                                            ChunkPool* pool) {
+    const int powers = order + 2;
+    return reduce_chunks<GaussNewtonMoments<Scalar>>(
+        problem.size(), pool,
+        [&](std::size_t begin, std::size_t end) {
+          return GaussNewtonMoments<Scalar>::over(problem, begin, end, powers);
+        },
+        [powers](GaussNewtonMoments<Scalar>& total, const GaussNewtonMoments<Scalar>& next) {
+          total.add(next, powers);
+        });
+  }
+
   Scalar a_, c_;
   int order_;
   std::array<Scalar, kGaussNewtonOrder + 1> k01_{}, k10_{};
