@@ -96,31 +96,12 @@ class GeodesicRegression {
   }
 
  private:
-  static Result rejected(Rejection rejection) {
-    Result result;
-    result.status = Status::invalid_input;
-    result.message = std::move(rejection.message);
-    result.bad_index = rejection.index;
-    return result;
-  }
-
   // The fit itself, defined below the class (not inline), so that an
   // explicit instantiation declaration (bireg/regression/precompiled.hpp)
   // keeps a consumer from instantiating it again.
   template <class Observations, class Covariates>
   Result run(const Observations& observations, const Covariates& covariates,
              const std::vector<Scalar>& weights, const Endpoints* start) const;
-
-  // The step rule for this fit; the Gauss-Newton rule sums its moments on
-  // the pool.
-  template <class Rule>
-  Rule make_rule(const Problem<Scalar>& problem, ChunkPool* pool) const {
-    if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
-      return Rule(problem, options_.step_size, kGaussNewtonOrder, pool);
-    } else {
-      return Rule(problem, options_.step_size);
-    }
-  }
 
   Options options_;
 };
@@ -131,16 +112,17 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
     const Observations& observations, const Covariates& covariates,
     const std::vector<Scalar>& weights, const Endpoints* start) const {
   // 1. The problem, every input checked before any work.
-  if (auto rejection = validate_options(options_)) return rejected(*rejection);
+  if (auto rejection = validate_options(options_)) return rejected_result<G>(*rejection);
   const std::size_t n = observations.size();
   if (covariates.size() != n) {
-    return rejected({"observations and covariates differ in length (" + std::to_string(n) + " vs " +
-                     std::to_string(covariates.size()) + ")"});
+    return rejected_result<G>({"observations and covariates differ in length (" +
+                               std::to_string(n) + " vs " + std::to_string(covariates.size()) +
+                               ")"});
   }
-  if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
+  if (n < 2) return rejected_result<G>({"need at least 2 observations, got " + std::to_string(n)});
   Problem<Scalar> problem;
   if (auto rejection = make_problem(covariates, weights, options_.interval, problem)) {
-    return rejected(*rejection);
+    return rejected_result<G>(*rejection);
   }
   // The pool lives as long as this fit and serves every pass over the
   // observations (parallel.hpp); below kParallelMinimum there is none.
@@ -149,16 +131,16 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
   ChunkPool* const chunk_pool = pool ? &*pool : nullptr;
   if (auto rejection =
           check_observations<G>(observations, options_.element_tolerance, chunk_pool)) {
-    return rejected(*rejection);
+    return rejected_result<G>(*rejection);
   }
   if (start && (!G::is_element(start->first, options_.element_tolerance) ||
                 !G::is_element(start->second, options_.element_tolerance))) {
-    return rejected({std::string("the start is not a pair of elements of ") + G::name});
+    return rejected_result<G>({std::string("the start is not a pair of elements of ") + G::name});
   }
 
   // 2. The start.
   const ChartStart<G> chart = chart_start<G>(observations, problem, chunk_pool);
-  if (auto rejection = chart_rejection<G>(chart)) return rejected(*rejection);
+  if (auto rejection = chart_rejection<G>(chart)) return rejected_result<G>(*rejection);
   const Endpoints first = start ? *start : Endpoints(chart.g0, chart.g1);
 
   // 3. The iteration, with the chosen step rule (compiled once for every
@@ -183,34 +165,27 @@ typename GeodesicRegression<G>::Result GeodesicRegression<G>::run(
       for (std::size_t i = 0; i < n && first_bad < 0; ++i) {
         if (!result.residuals[i].allFinite()) first_bad = static_cast<std::ptrdiff_t>(i);
       }
-      return rejected(unevaluable_start<G>(first_bad));
+      return rejected_result<G>(unevaluable_start<G>(first_bad));
     }
     if (!state.series_converges) {  // no force was evaluated there: residuals alone
-      const Element g0_inverse = G::inverse(state.g0);
-      for (std::size_t i = 0; i < n; ++i) {
-        result.residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
-      }
+      residuals_alone<G>(observations, problem, state, result.residuals);
     } else {  // K at the endpoints: the Gauss-Newton rule's, or built here (O(N))
       result.jacobian = rule.gauss_newton()
                             ? rule.gauss_newton()->matrix(state.a)
                             : GaussNewtonStep<G>(problem, Scalar(0)).matrix(state.a);
     }
-    result.status = record.status;
-    result.iterations = record.iterations;
-    result.diagnostics =
-        diagnose<G>(problem, rule, record, state, chart.spread, result.residuals, chunk_pool);
-    result.step_norms = std::move(record.step_norms);
-    result.iterates = std::move(record.iterates);
-    result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
-                                  static_cast<Scalar>(problem.t_max));
+    fill_result<G>(
+        result, problem, state, record,
+        diagnose<G>(problem, rule, record, state, chart.spread, result.residuals, chunk_pool));
     return result;
   };
-  return with_step_rule<G>(options_.solver, [&](auto tag) {
-    using Rule = typename decltype(tag)::type;
-    if (auto rejection = Rule::refuse(problem, options_.step_size)) return rejected(*rejection);
-    const Rule rule = make_rule<Rule>(problem, chunk_pool);
-    return iterate_and_diagnose(StepRuleView<G>(rule));
-  });
+  // The Gauss-Newton rule sums its moments on the pool.
+  return with_step_rule_view<G>(
+      options_.solver, problem, options_.step_size,
+      [&] {
+        return GaussNewtonStep<G>(problem, options_.step_size, kGaussNewtonOrder, chunk_pool);
+      },
+      rejected_result<G>, iterate_and_diagnose);
 }
 
 }  // namespace bireg

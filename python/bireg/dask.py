@@ -312,8 +312,9 @@ def _block_sums(t, Y, *w, group, request, block_info=None):
     offset = block_info[0]["array-location"][0][0]
     weights = np.ascontiguousarray(w[0][:, 0, 0], dtype=np.float64) if w else np.empty(0)
     out = np.empty((1, 1, 1), dtype=object)
-    out[0, 0, 0] = _bireg.chunk_sums(group, request, np.ascontiguousarray(t[:, 0, 0], dtype=np.float64),
-                               np.ascontiguousarray(Y, dtype=np.float64), weights, offset)
+    out[0, 0, 0] = _bireg.chunk_sums(group, request,
+                                     np.ascontiguousarray(t[:, 0, 0], dtype=np.float64),
+                                     np.ascontiguousarray(Y, dtype=np.float64), weights, offset)
     return out
 
 

@@ -108,14 +108,6 @@ class GeodesicRegression:
             raise ValueError("this GeodesicRegression is not fitted yet: call fit(t, Y) first")
         return self._fit
 
-    def _fitted_here(self, what):
-        """The fit, when its observations are in this process."""
-        fit = self._fitted()
-        if fit.chunked:
-            raise ValueError(f"{what} needs the observations in this process: a fit by "
-                             "bireg.dask.fit keeps them on the workers (fit locally for it)")
-        return fit
-
     def predict(self, t):
         """The fitted geodesic at t: (M,) -> (M, n, n)."""
         return self._fitted().predict(_arrays.covariates(t))
@@ -136,18 +128,18 @@ class GeodesicRegression:
     def covariance(self, flavour="robust"):
         """Endpoint and velocity covariances (left-trivialised) and standard
         errors: a dict (bireg::covariance and velocity_covariance)."""
-        return _bireg.covariance(self._fitted_here("covariance"), flavour)
+        return _bireg.covariance(self._fitted(), flavour)
 
     def confidence_band(self, t, level=0.95, flavour="robust"):
         """Per covariate, the half-widths of the pose's confidence region
         along each body-frame coordinate: (M,) -> (M, d)."""
-        return _bireg.confidence_band(self._fitted_here("confidence_band"), _arrays.covariates(t), float(level),
+        return _bireg.confidence_band(self._fitted(), _arrays.covariates(t), float(level),
                                       flavour)
 
     def trend_test(self, permutations=999, seed=0, threads=1):
         """The permutation test of 'no trend' (Wilks' Lambda): a dict with
         statistic and p_value (bireg::trend_test)."""
-        return _bireg.trend_test(self._fitted_here("trend_test"), _arrays.positive_int(permutations, "permutations"),
+        return _bireg.trend_test(self._fitted(), _arrays.positive_int(permutations, "permutations"),
                                  _arrays.positive_int(seed, "seed"),
                                  _arrays.positive_int(threads, "threads"))
 

@@ -38,14 +38,17 @@ std::unique_ptr<FitHandle> GroupFitter<G>::fit(const FitRequest& request) {
 namespace chunk_numbers {
 
 // The record of numbers that a Python transport carried; ValueError when
-// their layout is not this module's (another bireg version wrote them).
+// bireg::from_numbers refuses them: their count is not this module's
+// layout (another bireg version wrote them), a number does not fit its
+// field, or the request is one a worker must not run.
 template <class Record>
 Record read(const double* numbers, std::size_t count, const char* what) {
   auto record = bireg::from_numbers<Record>(numbers, count);
   if (!record) {
     refuse(std::string("the ") + what + " has " + std::to_string(count) +
-           " numbers, not this bireg version's layout (every worker needs the client's "
-           "version)");
+           " numbers that this bireg version refuses: another version's layout (every worker "
+           "needs the client's version), a value that does not fit its field, or, for a "
+           "request, one that a worker must not run");
   }
   return *record;
 }

@@ -100,6 +100,7 @@ nb::dict covariance_dict(const GroupFit<G>& fit, const std::string& flavour) {
 template <class G>
 Output confidence_band(const GroupFit<G>& fit, const Vector& t, double level,
                        const std::string& flavour) {
+  fit.require_observations("confidence_band");
   if (!(level > 0 && level < 1)) refuse("confidence_band: level must lie in (0, 1)");
   const bireg::FitCovariance<G> c = covariance_of(fit, flavour_of(flavour));
   const std::optional<double> q = bireg::pose_quantile(c, level);

@@ -272,11 +272,15 @@ def test_one_fit_over_unequal_chunks_is_the_local_fit(client, rng):
     from_numpy = bireg.dask.fit(t, Y, group="SE3", sample_weight=w, client=client,
                                 chunk_size=30001)
     assert_close_fits(from_numpy, weighted)
-    # A chunked fit has no residuals, covariance or band here.
+    # A chunked fit has no residuals, covariance, band or trend test here.
     with pytest.raises(AttributeError, match="residuals"):
         from_numpy.residuals_
-    with pytest.raises(ValueError, match="observations in this process"):
+    with pytest.raises(ValueError, match="^covariance: this fit's observations are with"):
         from_numpy.covariance()
+    with pytest.raises(ValueError, match="^confidence_band: this fit's observations are with"):
+        from_numpy.confidence_band(t[:5])
+    with pytest.raises(ValueError, match="^trend_test: this fit's observations are with"):
+        from_numpy.trend_test(permutations=9)
     np.testing.assert_allclose(from_numpy.predict(t[:5]), weighted.predict(t[:5]), rtol=0,
                                atol=1e-12)
 
@@ -298,6 +302,31 @@ def test_a_chunked_fit_refuses_bad_data_with_the_global_index(client, rng):
         bireg.dask.fit(t[:-1], Y, group="SE3", client=client)
     with pytest.raises(ValueError, match="unknown solver"):
         bireg.dask.fit(t, Y, group="SE3", solver="newton", client=client)
+
+
+def test_numbers_a_worker_cannot_take_are_refused():
+    """chunk_sums refuses a request of another layout, with a value that
+    does not fit its field, or that a worker must not run."""
+    from bireg import _bireg
+    requests = []
+
+    def reduce(request):
+        requests.append(np.array(request))
+        raise RuntimeError("only the first request is wanted")
+
+    with pytest.raises(RuntimeError, match="only the first request"):
+        _bireg.fit_by_chunks("SO3", reduce, "gauss_newton", "exact", 1e-10, 100)
+    request = requests[0]
+    t = np.linspace(0.0, 1.0, 3)
+    Y = np.broadcast_to(np.eye(3), (3, 3, 3)).copy()
+    assert _bireg.chunk_sums("SO3", request, t, Y, np.empty(0), 0).ndim == 1
+    half_pass, no_pass = request.copy(), request.copy()
+    half_pass[0] = 0.5  # the pass is an enumeration
+    no_pass[0] = 7      # no such pass
+    for bad in (request[:-1], half_pass, no_pass):
+        with pytest.raises(ValueError, match=f"^the request has {bad.size} numbers that this "
+                                             "bireg version refuses: another version's layout"):
+            _bireg.chunk_sums("SO3", bad, t, Y, np.empty(0), 0)
 
 
 @pytest.mark.parametrize("kind", ["relabellings", "map", "fit"])

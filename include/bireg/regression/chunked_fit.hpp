@@ -229,11 +229,8 @@ void add_slice_sums(const ChunkRequest<G>& request, const Observations& observat
         if (state.series_converges) slice.force = state.force;
         break;
       }
-      if (!state.series_converges) {  // no force was evaluated there: residuals alone
-        const typename G::Element g0_inverse = G::inverse(state.g0);
-        for (std::size_t i = 0; i < n; ++i)
-          residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
-      }
+      if (!state.series_converges)  // no force was evaluated there: residuals alone
+        residuals_alone<G>(observations, problem, state, residuals);
       slice.residuals = ResidualSums<G>::over(problem, residuals, 0, n, offset);
       break;
     }
@@ -292,6 +289,17 @@ void each(T& x, Number&& number) {
   }
 }
 
+// The integer type of T's values: T itself, or an enumeration's
+// underlying type.
+template <class T, bool = std::is_enum_v<T>>
+struct IntegerOf {
+  using type = T;
+};
+template <class T>
+struct IntegerOf<T, true> {
+  using type = std::underlying_type_t<T>;
+};
+
 // A number as a double, and back (enumerations by their value). Back
 // refuses (false) what the type cannot hold: a bool other than 0 or 1, an
 // integer or enumeration value that is not an integer in the type's range
@@ -311,9 +319,7 @@ bool from_double(double x, T& out) {
     if (x != 0 && x != 1) return false;
     out = x == 1;
   } else if constexpr (std::is_enum_v<T> || std::is_integral_v<T>) {
-    using Integer =
-        std::conditional_t<std::is_enum_v<T>, std::underlying_type<T>, std::enable_if<true, T>>;
-    using I = typename Integer::type;
+    using I = typename IntegerOf<T>::type;
     // 2^53: every integer below is exact in a double, and fits in 64 bits.
     constexpr double kExact = 9007199254740992.0;
     const double low = std::max(double(std::numeric_limits<I>::min()), -kExact);
@@ -403,14 +409,7 @@ RegressionResult<G> fit_by_chunks(const RegressionOptions<typename G::Scalar>& o
                                   Reduce& reduce) {
   using Scalar = typename G::Scalar;
   using Result = RegressionResult<G>;
-  const auto rejected = [](Rejection rejection) {
-    Result result;
-    result.status = Status::invalid_input;
-    result.message = std::move(rejection.message);
-    result.bad_index = rejection.index;
-    return result;
-  };
-  if (auto rejection = validate_options(options)) return rejected(*rejection);
+  if (auto rejection = validate_options(options)) return rejected_result<G>(*rejection);
   ChunkRequest<G> request;
   request.element_tolerance = options.element_tolerance;
   if (options.interval) {
@@ -423,19 +422,19 @@ RegressionResult<G> fit_by_chunks(const RegressionOptions<typename G::Scalar>& o
   request.pass = ChunkPass::survey;
   const ChunkSums<G> survey = reduce(request);
   const std::size_t n = survey.covariates.count;
-  if (n < 2) return rejected({"need at least 2 observations, got " + std::to_string(n)});
+  if (n < 2) return rejected_result<G>({"need at least 2 observations, got " + std::to_string(n)});
   if (auto rejection =
           covariate_frame(survey.covariates, survey.weighted, options.interval, request.frame)) {
-    return rejected(*rejection);
+    return rejected_result<G>(*rejection);
   }
   request.pass = ChunkPass::design;
   const ChunkSums<G> design = reduce(request);
   Problem<Scalar> problem;  // H and the frame; the covariates stay with the chunks
   problem.t_min = request.frame.t_min;
   problem.t_max = request.frame.t_max;
-  if (auto rejection = set_design(design.design, problem)) return rejected(*rejection);
+  if (auto rejection = set_design(design.design, problem)) return rejected_result<G>(*rejection);
   if (auto rejection = observation_rejection<G>(survey.observations, options.element_tolerance)) {
-    return rejected(*rejection);
+    return rejected_result<G>(*rejection);
   }
 
   // 2. The start.
@@ -443,47 +442,36 @@ RegressionResult<G> fit_by_chunks(const RegressionOptions<typename G::Scalar>& o
   request.g0 = design.middle.element;
   const ChartStart<G> chart =
       chart_from_sums<G>(design.middle.element, problem, reduce(request).chart);
-  if (auto rejection = chart_rejection<G>(chart)) return rejected(*rejection);
+  if (auto rejection = chart_rejection<G>(chart)) return rejected_result<G>(*rejection);
 
   // 3. The iteration, each evaluation a force request; 4. the diagnostics.
   const ChunkedObservations<G, Reduce> observations{&reduce, request};
-  return with_step_rule<G>(options.solver, [&](auto tag) {
-    using Rule = typename decltype(tag)::type;
-    if (auto rejection = Rule::refuse(problem, options.step_size)) return rejected(*rejection);
-    const Rule rule = [&] {
-      if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
-        return Rule(problem, design.moments);
-      } else {
-        return Rule(problem, options.step_size);
-      }
-    }();
-    const StepRuleView<G> view(rule);
+  const auto iterate_and_diagnose = [&](const StepRuleView<G>& rule) {
     const IterationControl<Scalar> control{options.tolerance, options.max_iterations,
                                            options.record_iterates};
     Result result;
     IterationRecord<G> record;
-    const State<G> state = iterate<G>(observations, problem, request.psi, view, control, chart.g0,
+    const State<G> state = iterate<G>(observations, problem, request.psi, rule, control, chart.g0,
                                       chart.g1, chart.reference, result.residuals, record);
     request.pass = ChunkPass::residuals;
     request.g0 = state.g0;
     request.g1 = state.g1;
     const ResidualSums<G> residual_sums = reduce(request).residuals;
     if (state.series_converges && !state.usable()) {
-      return rejected(unevaluable_start<G>(residual_sums.not_finite));
+      return rejected_result<G>(unevaluable_start<G>(residual_sums.not_finite));
     }
     if (state.series_converges) {
       result.jacobian = GaussNewtonStep<G>(problem, design.moments).matrix(state.a);
     }
-    result.status = record.status;
-    result.iterations = record.iterations;
-    result.diagnostics =
-        diagnose_from_sums<G>(problem, view, record, state, chart.spread, residual_sums);
-    result.step_norms = std::move(record.step_norms);
-    result.iterates = std::move(record.iterates);
-    result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
-                                  static_cast<Scalar>(problem.t_max));
+    fill_result<G>(
+        result, problem, state, record,
+        diagnose_from_sums<G>(problem, rule, record, state, chart.spread, residual_sums));
     return result;
-  });
+  };
+  return with_step_rule_view<G>(
+      options.solver, problem, options.step_size,
+      [&] { return GaussNewtonStep<G>(problem, design.moments); }, rejected_result<G>,
+      iterate_and_diagnose);
 }
 
 }  // namespace bireg

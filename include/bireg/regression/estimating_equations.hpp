@@ -336,4 +336,15 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
   return state;
 }
 
+// The residuals at a state's endpoints alone, into `residuals` (sized N):
+// for a state outside the series' disc, where evaluate() computed none.
+template <class G, class Observations>
+void residuals_alone(const Observations& observations, const Problem<typename G::Scalar>& problem,
+                     const State<G>& state, std::vector<typename G::Tangent>& residuals) {
+  const std::size_t n = observations.size();
+  const typename G::Element g0_inverse = G::inverse(state.g0);
+  for (std::size_t i = 0; i < n; ++i)
+    residuals[i] = residual<G>(g0_inverse, state.x, problem.t[i], observations[i]);
+}
+
 }  // namespace bireg

@@ -11,6 +11,9 @@
 
 #include "bireg/geodesic.hpp"
 #include "bireg/regression/diagnostics.hpp"
+#include "bireg/regression/estimating_equations.hpp"
+#include "bireg/regression/iteration.hpp"
+#include "bireg/regression/problem.hpp"
 #include "bireg/regression/status.hpp"
 
 namespace bireg {
@@ -46,5 +49,33 @@ struct RegressionResult {
 
   bool ok() const { return is_success(status); }
 };
+
+// The result of a fit refused before any work (Status::invalid_input).
+template <class G>
+RegressionResult<G> rejected_result(Rejection rejection) {
+  RegressionResult<G> result;
+  result.status = Status::invalid_input;
+  result.message = std::move(rejection.message);
+  result.bad_index = rejection.index;
+  return result;
+}
+
+// Fills `result` from where the iteration ended: its status, count, step
+// norms and iterates (moved out of `record`), the `diagnostics` (computed
+// from `record` before this call) and the geodesic through the final
+// state's endpoints in the covariates' units.
+template <class G>
+void fill_result(RegressionResult<G>& result, const Problem<typename G::Scalar>& problem,
+                 const State<G>& state, IterationRecord<G>& record,
+                 RegressionDiagnostics<typename G::Scalar> diagnostics) {
+  using Scalar = typename G::Scalar;
+  result.status = record.status;
+  result.iterations = record.iterations;
+  result.diagnostics = std::move(diagnostics);
+  result.step_norms = std::move(record.step_norms);
+  result.iterates = std::move(record.iterates);
+  result.geodesic = Geodesic<G>(state.g0, state.g1, static_cast<Scalar>(problem.t_min),
+                                static_cast<Scalar>(problem.t_max));
+}
 
 }  // namespace bireg

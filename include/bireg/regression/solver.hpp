@@ -108,4 +108,28 @@ class StepRuleView {
   const GaussNewtonStep<G>* gauss_newton_ = nullptr;
 };
 
+// A fit's step rule, by name, run: calls run(StepRuleView<G>(rule)) with
+// the rule `solver` names for `problem`, or returns refused(rejection) when
+// that rule refuses the problem (Rule::refuse). The Gauss-Newton rule is
+// gauss_newton()'s (its moments summed wherever the caller's observations
+// are), the others are built from step_size. run and refused return the
+// same type.
+template <class G, class GaussNewton, class Refused, class Run>
+auto with_step_rule_view(Solver solver, const Problem<typename G::Scalar>& problem,
+                         typename G::Scalar step_size, GaussNewton&& gauss_newton,
+                         Refused&& refused, Run&& run) {
+  return with_step_rule<G>(solver, [&](auto tag) {
+    using Rule = typename decltype(tag)::type;
+    if (auto rejection = Rule::refuse(problem, step_size)) return refused(*rejection);
+    const Rule rule = [&] {
+      if constexpr (std::is_same_v<Rule, GaussNewtonStep<G>>) {
+        return gauss_newton();
+      } else {
+        return Rule(problem, step_size);
+      }
+    }();
+    return run(StepRuleView<G>(rule));
+  });
+}
+
 }  // namespace bireg
