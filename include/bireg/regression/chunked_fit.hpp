@@ -106,6 +106,7 @@ struct ChunkRequest {
     f(self.psi.method);
     f(self.psi.series_order);
     f(self.psi.max_series_order);
+    f(self.psi.batched);
     f(self.g0);
     f(self.g1);
   }

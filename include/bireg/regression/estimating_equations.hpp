@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <limits>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "bireg/groups/capabilities.hpp"
 #include "bireg/math/psi_closed_form.hpp"
 #include "bireg/math/psi_series.hpp"
+#include "bireg/regression/batched_force.hpp"
 #include "bireg/regression/parallel.hpp"
 #include "bireg/regression/problem.hpp"
 #include "bireg/regression/status.hpp"
@@ -36,6 +38,7 @@ struct PsiEvaluation {
   Method method = Method::exact;
   int series_order = 0;  // for Method::series; 0 = adaptive
   int max_series_order = kMaxSeriesOrder;
+  bool batched = true;  // the batched kernels where built (batched_force.hpp)
 };
 
 template <class G>
@@ -186,13 +189,15 @@ Force<G> series_force(const Observations& observations, const Problem<typename G
 // coefficients times fixed maps (ClosedFormPsi::kTerms; not Sim(3)), the
 // weighted residuals are summed per coefficient and the maps applied once
 // per chunk (psi_closed_form::apply_by_coefficients); otherwise each
-// observation's psi_s r is evaluated.
+// observation's psi_s r is evaluated. With batched, SO(3)'s and SE(3)'s loops run
+// across observations in SIMD lanes where this build has the kernel
+// (batched_force.hpp).
 template <class G, class Observations>
 Force<G> closed_form_force(const Observations& observations,
                            const Problem<typename G::Scalar>& problem,
                            const typename G::Element& g0, const typename G::Tangent& x,
                            std::vector<typename G::Tangent>& residuals,
-                           ForceWorkspace<G>* workspace) {
+                           ForceWorkspace<G>* workspace, [[maybe_unused]] bool batched) {
   using Scalar = typename G::Scalar;
   using Tangent = typename G::Tangent;
   using Psi = typename G::ClosedFormPsi;
@@ -216,6 +221,17 @@ Force<G> closed_form_force(const Observations& observations,
   // The force of observations [begin, end), from zero.
   const auto accumulate = [&](std::size_t begin, std::size_t end) {
     if constexpr (provides_v<Psi, capability_detail::closed_form_terms>) {
+#if BIREG_HAS_BATCHED_FORCE
+      if constexpr (batched::has_closed_form_sums_v<G>) {
+        if (batched) {
+          const auto sums = batched::closed_form_sums(G{}, observations, problem.t.data(),
+                                                      problem.w.data(), begin, end, g0_inverse,
+                                                      forward, backward, residuals.data());
+          return Force<G>{Psi::combine(backward, sums.v0_sums),
+                          Psi::combine(forward, sums.v1_sums)};
+        }
+      }
+#endif
       // sums[k] = sum_i w_i c_k(s_i) r_i for each direction.
       std::array<Tangent, Psi::kTerms> v0_sums, v1_sums;
       for (int k = 0; k < Psi::kTerms; ++k) {
@@ -327,7 +343,7 @@ State<G> evaluate(const Observations& observations, const Problem<typename G::Sc
   if constexpr (has_closed_form_psi_v<G>) {
     if (closed_form) {
       state.force = estimating_detail::closed_form_force<G>(observations, problem, g0, state.x,
-                                                            residuals, workspace);
+                                                            residuals, workspace, psi.batched);
       return state;
     }
   }

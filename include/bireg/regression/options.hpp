@@ -61,9 +61,16 @@ struct RegressionOptions {
   // start leaves fewer, never an error. The results are bit-identical for
   // any value. 1 (the default): no thread is ever started.
   int threads = 1;
+  // Use the batched kernels where this build has them
+  // (regression/batched_force.hpp: the closed-form force of SO(3) and
+  // SE(3), compiled with Highway for AVX2 or AVX-512); false keeps the
+  // scalar loop everywhere. The two agree to rounding (a fit's endpoints
+  // within 1e-13 of each other in the group's distance;
+  // tests/test_batched_force.cpp).
+  bool batched_kernels = true;
 
   // How the estimating equations evaluate psi, from the fields above.
-  PsiEvaluation psi() const { return {method, series_order, max_series_order}; }
+  PsiEvaluation psi() const { return {method, series_order, max_series_order, batched_kernels}; }
 };
 
 template <class Scalar>
