@@ -201,14 +201,19 @@ inline std::optional<double> f_quantile(double level, double d1, double d2) {
 // Mahalanobis distance of one normal p-vector with its covariance
 // estimated from a Wishart(nu) scatter): T^2 = nu p / (nu - p + 1) F(p,
 // nu - p + 1). Exact on R^n for a single vector (the velocity, the pose at
-// one covariate, a prediction). Needs nu > p - 1.
+// one covariate, a prediction). Needs nu > p - 1. None where the quantile
+// is not a number: p and nu both near the largest double with
+// nu - p + 1 small make nu p / (nu - p + 1) overflow while F's quantile
+// underflows to 0 (found by fuzz_statistics: p = nu = 1e300).
 inline std::optional<double> hotelling_quantile(double level, double p, double nu) {
   const double denominator = nu - p + 1;
   if (!(denominator > 0)) return std::nullopt;
   const std::optional<double> f = f_quantile(level, p, denominator);
   if (!f) return std::nullopt;
   // nu / (nu - p + 1) first: nu p alone overflows for nu near the largest double.
-  return nu / denominator * p * *f;
+  const double quantile = nu / denominator * p * *f;
+  if (std::isnan(quantile)) return std::nullopt;
+  return quantile;
 }
 
 // The Lawley-Hotelling trace U = nu tr(B E^{-1}), B ~ Wishart_p(q), E ~
