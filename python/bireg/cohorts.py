@@ -251,8 +251,7 @@ def fit_many(subjects, group, interval=None, threads=1):
     (``interval``, or from the smallest to the largest covariate of all
     subjects): a trend's ends are comparable between subjects only on one
     interval. Raises ValueError if any subject's fit fails, naming the
-    first (no trend is returned for a fit that did not succeed). The
-    Python module has trends for SO3 and SE3.
+    first (no trend is returned for a fit that did not succeed).
     """
     t0, t1 = _interval(interval)
     threads = _arrays.positive_int(threads, "threads")

@@ -1,9 +1,9 @@
 // The cohorts layer (bireg/statistics/cohorts/): the two-sample test of
 // group elements, the element-wise map, the library's functions that join
 // shares of them computed apart (bireg.dask), and the subjects' trends
-// (fit_many, compare_trends, population_trend; SO3 and SE3). Each function calls the
-// library's and converts; the GIL is released while it works. A refusal,
-// or a mean that failed, is a ValueError with the library's message.
+// (fit_many, compare_trends, population_trend; one file per group,
+// cohorts.hpp). Each function calls the library's and converts; the GIL is released while it works.
+// A refusal, or a mean that failed, is a ValueError with the library's message.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -11,57 +11,12 @@
 
 #include <nanobind/stl/vector.h>
 
-#include "common.hpp"
-#include "fit_handle.hpp"
+#include "cohorts.hpp"
 
 #include "bireg/statistics/cohorts/elementwise.hpp"
-#include "bireg/statistics/cohorts/trends.hpp"
-#include "bireg/statistics/cohorts/two_sample.hpp"
 
 namespace bireg_python {
 namespace {
-
-bireg::TwoSampleOptions<double> test_options(const std::string& statistic,
-                                             const std::string& variant, int permutations,
-                                             std::uint64_t seed, int threads,
-                                             std::uint64_t first_permutation = 0) {
-  bireg::TwoSampleOptions<double> options;
-  options.statistic =
-      parse_choice(statistic,
-                   {bireg::TwoSampleStatistic::hotelling, bireg::TwoSampleStatistic::bhattacharyya,
-                    bireg::TwoSampleStatistic::hellinger},
-                   "statistic");
-  options.variant = parse_choice(
-      variant, {bireg::TwoSampleVariant::invariant, bireg::TwoSampleVariant::published}, "variant");
-  options.permutations = permutations;
-  options.seed = seed;
-  options.threads = threads;
-  options.first_permutation = first_permutation;
-  return options;
-}
-
-// The fields of a two-sample result; `element` writes a mean as an array
-// (a matrix, or a trend's two).
-template <class G, class WriteElement>
-nb::dict test_dict(const bireg::TwoSampleResult<G>& result, const WriteElement& element) {
-  nb::dict out;
-  out["statistic"] = std::string(to_string(result.statistic));
-  out["variant"] = std::string(to_string(result.variant));
-  out["value"] = result.value;
-  out["p_value"] = result.p_value;
-  out["seed"] = result.seed;
-  out["first_permutation"] = result.first_permutation;
-  out["permutations"] = result.permutations;
-  out["at_least_as_extreme"] = result.at_least_as_extreme;
-  out["failed_permutations"] = result.failed_permutations;
-  out["mean_a"] = element(*result.mean_a);
-  out["mean_b"] = element(*result.mean_b);
-  out["mean_difference"] = vector_array(result.mean_difference);
-  out["covariance_a"] = matrix_array(result.covariance_a);
-  out["covariance_b"] = matrix_array(result.covariance_b);
-  out["covariance_b_compared"] = matrix_array(result.covariance_b_compared);
-  return out;
-}
 
 template <class G>
 nb::dict two_sample(const Stack& a, const Stack& b,
@@ -191,172 +146,6 @@ nb::dict combine_elementwise(const std::vector<nb::dict>& slices) {
   return out;
 }
 
-using Trends = nb::ndarray<const double, nb::ndim<4>, nb::c_contig, nb::device::cpu>;
-
-// The groups whose trends the module compiles: the trend functions are
-// instantiated on G x G, and each group costs minutes of compile time and
-// gigabytes of the compiler's memory; the C++ library has them for every
-// group.
-inline constexpr const char* kTrendGroups = "SO3, SE3";
-
-template <class F>
-nb::dict with_trend_group(const std::string& name, const char* function, F&& f) {
-  if (name == "SO3") return f(Tag<bireg::SO3d>{});
-  if (name == "SE3") return f(Tag<bireg::SE3d>{});
-  return with_group(name, [&](auto) -> nb::dict {
-    refuse(std::string(function) + ": the Python module has trends for " + kTrendGroups + ", not " +
-           name + " (the C++ library has them for every group)");
-  });
-}
-
-// A stack of trends, numpy's (S, 2, n, n) in C order, seen as the
-// library's elements (gamma(t0), gamma(t1)) of G x G.
-template <class G>
-class TrendView {
- public:
-  using Element = bireg::Trend<G>;
-  explicit TrendView(const Trends& a) : data_(a.data()), size_(a.shape(0)) {}
-  std::size_t size() const { return size_; }
-  Element operator[](std::size_t i) const {
-    const StackView<G> pair(data_ + 2 * i * kEntries, 2);
-    return {pair[0], pair[1]};
-  }
-
- private:
-  static constexpr std::size_t kEntries = std::size_t(side<G>() * side<G>());
-  const double* data_ = nullptr;
-  std::size_t size_ = 0;
-};
-
-template <class G>
-void write_trend(const bireg::Trend<G>& trend, double* out) {
-  constexpr std::size_t entries = std::size_t(side<G>() * side<G>());
-  write_row_major(trend.first, out);
-  write_row_major(trend.second, out + entries);
-}
-
-template <class G>
-Output trend_array(const bireg::Trend<G>& trend) {
-  NewArray a({2, std::size_t(side<G>()), std::size_t(side<G>())});
-  write_trend<G>(trend, a.data());
-  return a.release();
-}
-
-// Every subject fitted; a subject whose fit failed refuses the whole call
-// (the library's message names the first and counts them), so that no
-// trend is returned for a fit that did not succeed.
-template <class G>
-nb::dict fit_many_dict(const std::vector<Vector>& t, const std::vector<Stack>& y, double t0,
-                       double t1, int threads, std::size_t first_subject) {
-  if (t.size() != y.size())
-    refuse("fit_many: " + std::to_string(t.size()) + " covariate arrays for " +
-           std::to_string(y.size()) + " subjects");
-  std::vector<bireg::SubjectData<G>> subjects(t.size());
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i].shape(0) != y[i].shape(0))
-      refuse("fit_many: subject " + std::to_string(first_subject + i) + " has " +
-             std::to_string(t[i].shape(0)) + " covariates for " + std::to_string(y[i].shape(0)) +
-             " observations");
-    const StackView<G> view(y[i]);
-    subjects[i].covariates = to_vector(t[i]);
-    subjects[i].observations.reserve(view.size());
-    for (std::size_t k = 0; k < view.size(); ++k)
-      subjects[i].observations.push_back(view[k]);
-  }
-  bireg::FitManyOptions<double> options;
-  options.t0 = t0;
-  options.t1 = t1;
-  options.threads = threads;
-  options.first_subject = first_subject;
-  bireg::FitManyResult<G> result;
-  {
-    nb::gil_scoped_release release;
-    result = bireg::fit_many(bireg::GeodesicRegression<G>(), subjects, options);
-  }
-  if (!result.ok()) refuse("fit_many: " + result.message);
-  NewArray trends({result.trends.size(), 2, std::size_t(side<G>()), std::size_t(side<G>())});
-  for (std::size_t i = 0; i < result.trends.size(); ++i)
-    write_trend<G>(result.trends[i], trends.data() + i * 2 * side<G>() * side<G>());
-  NewArray iterations({result.fits.size()});
-  for (std::size_t i = 0; i < result.fits.size(); ++i)
-    iterations.data()[i] = result.fits[i].iterations;
-  nb::dict out;
-  out["t0"] = result.t0;
-  out["t1"] = result.t1;
-  out["trends"] = trends.release();
-  out["n_iter"] = iterations.release();
-  return out;
-}
-
-template <class G>
-nb::dict compare_trends_dict(const Trends& a, const Trends& b,
-                             const bireg::TwoSampleOptions<double>& options) {
-  using Pair = bireg::Product<G, G>;
-  bireg::TwoSampleResult<Pair> result;
-  {
-    nb::gil_scoped_release release;
-    result = bireg::compare_trends<G>(TrendView<G>(a), TrendView<G>(b), options);
-  }
-  if (!result.ok()) refuse(result.message);
-  return test_dict(result, [](const bireg::Trend<G>& mean) { return trend_array<G>(mean); });
-}
-
-// The trends' elements at covariate t, compared in G: a dict whose means
-// are matrices.
-template <class G>
-nb::dict compare_trends_at_dict(const Trends& a, const Trends& b, double t0, double t1, double t,
-                                const bireg::TwoSampleOptions<double>& options) {
-  bireg::TwoSampleResult<G> result;
-  {
-    nb::gil_scoped_release release;
-    result = bireg::compare_trends_at<G>(TrendView<G>(a), TrendView<G>(b), t0, t1, t, options);
-  }
-  if (!result.ok()) refuse("compare_trends_at: " + result.message);
-  return test_dict(result, [](const typename G::Element& mean) { return matrix_array(mean); });
-}
-
-// The trends' body velocities, compared as vectors: a dict whose means are
-// vectors of length d.
-template <class G>
-nb::dict compare_velocities_dict(const Trends& a, const Trends& b, double t0, double t1,
-                                 const bireg::TwoSampleOptions<double>& options) {
-  bireg::TwoSampleResult<bireg::Rn<G::dof, double>> result;
-  {
-    nb::gil_scoped_release release;
-    result = bireg::compare_velocities<G>(TrendView<G>(a), TrendView<G>(b), t0, t1, options);
-  }
-  if (!result.ok()) refuse("compare_velocities: " + result.message);
-  return test_dict(result, [](const typename G::Tangent& mean) { return vector_array(mean); });
-}
-
-template <class G>
-nb::dict population_trend_dict(const Trends& trends, double t0, double t1, double level,
-                               double outlier_level) {
-  bireg::PopulationOptions<double> options;
-  options.level = level;
-  options.outlier_level = outlier_level;
-  bireg::PopulationTrend<G> result;
-  {
-    nb::gil_scoped_release release;
-    result = bireg::population_trend<G>(TrendView<G>(trends), t0, t1, options);
-  }
-  if (!result.ok()) refuse("population_trend: " + result.message);
-  NewArray outlying({result.outlying.size()});
-  for (std::size_t i = 0; i < result.outlying.size(); ++i)
-    outlying.data()[i] = result.outlying[i] ? 1.0 : 0.0;
-  nb::dict out;
-  out["mean"] = trend_array<G>(*result.mean);
-  out["covariance"] = matrix_array(result.covariance);
-  out["mean_covariance"] = matrix_array(result.mean_covariance);
-  out["radius_squared"] = result.radius_squared;
-  out["velocity"] = vector_array(result.velocity);
-  out["velocity_covariance"] = matrix_array(result.velocity_covariance);
-  out["mahalanobis_squared"] = vector_array(result.mahalanobis_squared);
-  out["outlying"] = outlying.release();
-  out["outlier_threshold"] = result.outlier_threshold;
-  return out;
-}
-
 }  // namespace
 
 void bind_cohorts(nb::module_& m) {
@@ -420,8 +209,9 @@ void bind_cohorts(nb::module_& m) {
       "fit_many",
       [](const std::string& group, const std::vector<Vector>& t, const std::vector<Stack>& y,
          double t0, double t1, int threads, std::size_t first_subject) {
-        return with_trend_group(group, "fit_many", [&](auto tag) {
-          return fit_many_dict<typename decltype(tag)::type>(t, y, t0, t1, threads, first_subject);
+        return with_group(group, [&](auto tag) {
+          return TrendFunctions<typename decltype(tag)::type>::fit_many(t, y, t0, t1, threads,
+                                                                        first_subject);
         });
       },
       nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("t0"), nb::arg("t1"),
@@ -434,8 +224,8 @@ void bind_cohorts(nb::module_& m) {
          std::uint64_t first_permutation) {
         const auto options =
             test_options(statistic, variant, permutations, seed, threads, first_permutation);
-        return with_trend_group(group, "compare_trends", [&](auto tag) {
-          return compare_trends_dict<typename decltype(tag)::type>(a, b, options);
+        return with_group(group, [&](auto tag) {
+          return TrendFunctions<typename decltype(tag)::type>::compare_trends(a, b, options);
         });
       },
       nb::arg("group"), nb::arg("a"), nb::arg("b"), nb::arg("statistic"), nb::arg("variant"),
@@ -448,8 +238,9 @@ void bind_cohorts(nb::module_& m) {
          const std::string& statistic, const std::string& variant, int permutations,
          std::uint64_t seed, int threads) {
         const auto options = test_options(statistic, variant, permutations, seed, threads);
-        return with_trend_group(group, "compare_trends_at", [&](auto tag) {
-          return compare_trends_at_dict<typename decltype(tag)::type>(a, b, t0, t1, t, options);
+        return with_group(group, [&](auto tag) {
+          return TrendFunctions<typename decltype(tag)::type>::compare_trends_at(a, b, t0, t1, t,
+                                                                                 options);
         });
       },
       nb::arg("group"), nb::arg("a"), nb::arg("b"), nb::arg("t0"), nb::arg("t1"), nb::arg("t"),
@@ -461,8 +252,9 @@ void bind_cohorts(nb::module_& m) {
       [](const std::string& group, const Trends& a, const Trends& b, double t0, double t1,
          const std::string& statistic, int permutations, std::uint64_t seed, int threads) {
         const auto options = test_options(statistic, "invariant", permutations, seed, threads);
-        return with_trend_group(group, "compare_velocities", [&](auto tag) {
-          return compare_velocities_dict<typename decltype(tag)::type>(a, b, t0, t1, options);
+        return with_group(group, [&](auto tag) {
+          return TrendFunctions<typename decltype(tag)::type>::compare_velocities(a, b, t0, t1,
+                                                                                  options);
         });
       },
       nb::arg("group"), nb::arg("a"), nb::arg("b"), nb::arg("t0"), nb::arg("t1"),
@@ -472,9 +264,9 @@ void bind_cohorts(nb::module_& m) {
       "population_trend",
       [](const std::string& group, const Trends& trends, double t0, double t1, double level,
          double outlier_level) {
-        return with_trend_group(group, "population_trend", [&](auto tag) {
-          return population_trend_dict<typename decltype(tag)::type>(trends, t0, t1, level,
-                                                                     outlier_level);
+        return with_group(group, [&](auto tag) {
+          return TrendFunctions<typename decltype(tag)::type>::population_trend(
+              trends, t0, t1, level, outlier_level);
         });
       },
       nb::arg("group"), nb::arg("trends"), nb::arg("t0"), nb::arg("t1"), nb::arg("level"),

@@ -37,7 +37,10 @@ def algebra_basis(group):
         return [unit(4, i, 3) for i in range(3)] + rotations
     if group == "GLp3":
         return [unit(3, i, j) for i in range(3) for j in range(3)]
-    raise ValueError(group)
+    # Another group: the principal logs of exp(0.1 e_i), scaled back, span
+    # its algebra (bireg's exp only chooses the basis).
+    g = bireg.groups.get(group)
+    return [log(g.exp(0.1 * e)) / 0.1 for e in np.eye(g.dim)]
 
 
 def coordinates(x, basis):
@@ -262,17 +265,17 @@ def product_basis(group):
     return out
 
 
-def subjects_about(start, velocity, count, rng, spread=0.05, noise=0.02, shift=None):
+def subjects_about(start, velocity, count, rng, spread=0.05, noise=0.02, group="SO3"):
     """count subjects of 8 observations on t in [0, 1], each about the
     geodesic start exp(t velocity) moved by its own deviation."""
-    g = bireg.SO3
+    g = bireg.groups.get(group)
     out = []
     for _ in range(count):
-        own_start = g.compose(start, g.exp(spread * rng.standard_normal(3)))
-        own_velocity = velocity + spread * rng.standard_normal(3)
+        own_start = g.compose(start, g.exp(spread * rng.standard_normal(g.dim)))
+        own_velocity = velocity + spread * rng.standard_normal(g.dim)
         t = np.sort(rng.uniform(0, 1, 8))
         Y = g.compose(own_start, g.exp(t[:, None] * own_velocity))
-        out.append((t, g.compose(Y, g.exp(noise * rng.standard_normal((8, 3))))))
+        out.append((t, g.compose(Y, g.exp(noise * rng.standard_normal((8, g.dim))))))
     return out
 
 
@@ -311,16 +314,34 @@ def test_fit_many_refuses_when_a_subject_fails(rng):
         bireg.fit_many(subjects[:2], group="SO3", interval=(1.0, 0.0))
 
 
-def test_compare_trends_equals_the_test_on_block_diagonal_pairs(rng):
-    start = bireg.SO3.exp(np.array([0.1, 0.2, -0.3]))
-    a = bireg.fit_many(subjects_about(start, np.array([0.4, 0.0, 0.1]), 16, rng), group="SO3",
+TREND_GROUPS = ["SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3"]
+
+
+def trend_velocities(group):
+    """Two cohorts' mean velocities, 0.2 per unit apart in the first
+    coordinate (for SO3: (0.4, 0, 0.1) and (0.4, 0.2, 0.1))."""
+    if group == "SO3":
+        return np.array([0.4, 0.0, 0.1]), np.array([0.4, 0.2, 0.1])
+    dim = bireg.groups.get(group).dim
+    a = np.linspace(0.4, -0.2, dim)
+    return a, a + 0.2 * np.eye(dim)[0]
+
+
+@pytest.mark.parametrize("group", TREND_GROUPS)
+def test_compare_trends_equals_the_test_on_block_diagonal_pairs(group, rng):
+    g = bireg.groups.get(group)
+    n = g.matrix_size
+    start = g.exp(np.linspace(0.1, -0.3, g.dim))
+    v_a, v_b = trend_velocities(group)
+    a = bireg.fit_many(subjects_about(start, v_a, 16, rng, group=group), group=group,
                        interval=(0.0, 1.0)).trends
-    b = bireg.fit_many(subjects_about(start, np.array([0.4, 0.2, 0.1]), 18, rng), group="SO3",
+    b = bireg.fit_many(subjects_about(start, v_b, 18, rng, group=group), group=group,
                        interval=(0.0, 1.0)).trends
-    result = bireg.compare_trends(a, b, group="SO3", permutations=999, seed=5)
-    assert result.mean_a.shape == (2, 3, 3) and result.covariance_a.shape == (6, 6)
+    result = bireg.compare_trends(a, b, group=group, permutations=999, seed=5)
+    assert result.mean_a.shape == (2, n, n)
+    assert result.covariance_a.shape == (2 * g.dim, 2 * g.dim)
     # The same statistic computed from scratch on G x G as block-diagonal matrices.
-    basis = product_basis("SO3")
+    basis = product_basis(group)
     pa, pb = block_diagonal(a), block_diagonal(b)
     m_a, m_b = group_mean(pa), group_mean(pb)
     x_a = np.array([coordinates(log(np.linalg.solve(m_a, f)), basis) for f in pa])
@@ -331,20 +352,28 @@ def test_compare_trends_equals_the_test_on_block_diagonal_pairs(rng):
     s_b = transport @ (x_b.T @ x_b / len(pb)) @ transport.T
     pooled = (x_a.T @ x_a + len(pb) * s_b) / (len(pa) + len(pb) - 2)
     t2 = len(pa) * len(pb) / (len(pa) + len(pb)) * c @ np.linalg.solve(pooled, c)
-    assert result.value == pytest.approx(t2, rel=1e-10)
-    # A velocity that differs by 0.2 rad/unit, four between-subject
-    # standard deviations: detected.
-    assert result.p_value <= 0.01
-    same = bireg.compare_trends(a[:8], a[8:], group="SO3", permutations=999, seed=5)
-    assert same.p_value > 0.01
+    # bireg's means (chord steps, two_sample.hpp's split_mean) stop once a
+    # step is at most MeanOptions' tolerance, 1e-10, so each is within about
+    # 1e-10 of the root found here to 1e-15; c moves by up to 2e-10, and T^2,
+    # quadratic in c, by up to 2 * 2e-10 / |c| relative (the covariances'
+    # share is smaller: residuals of size ~0.05 move by 1e-10).
+    assert result.value == pytest.approx(t2, rel=4e-10 / np.linalg.norm(c))
+    if group == "SO3":
+        # A velocity that differs by 0.2 rad/unit, four between-subject
+        # standard deviations: detected.
+        assert result.p_value <= 0.01
+        same = bireg.compare_trends(a[:8], a[8:], group="SO3", permutations=999, seed=5)
+        assert same.p_value > 0.01
 
 
-def test_population_trend_against_its_definition(rng):
-    start, velocity = bireg.SO3.exp(np.array([0.3, 0.0, 0.1])), np.array([0.2, -0.3, 0.5])
-    trends = bireg.fit_many(subjects_about(start, velocity, 30, rng), group="SO3",
+@pytest.mark.parametrize("group", TREND_GROUPS)
+def test_population_trend_against_its_definition(group, rng):
+    g = bireg.groups.get(group)
+    start, velocity = g.exp(np.linspace(0.3, 0.1, g.dim)), np.linspace(0.2, -0.3, g.dim)
+    trends = bireg.fit_many(subjects_about(start, velocity, 30, rng, group=group), group=group,
                             interval=(0.0, 2.0)).trends
-    population = bireg.population_trend(trends, (0.0, 2.0), group="SO3")
-    basis = product_basis("SO3")
+    population = bireg.population_trend(trends, (0.0, 2.0), group=group)
+    basis = product_basis(group)
     pairs = block_diagonal(trends)
     mean = group_mean(pairs)
     assert np.allclose(block_diagonal(population.mean[None])[0], mean, atol=1e-12)
@@ -355,10 +384,11 @@ def test_population_trend_against_its_definition(rng):
     distances = np.einsum("ij,ij->i", y, np.linalg.solve(s, y.T).T)
     assert np.allclose(population.mahalanobis_squared, distances, rtol=1e-9)
     m0, m1 = population.mean
-    assert np.allclose(population.velocity, bireg.SO3.log(m0.T @ m1) / 2.0, atol=1e-12)
+    assert np.allclose(population.velocity, g.log(np.linalg.solve(m0, m1)) / 2.0, atol=1e-12)
     assert population.outlying.dtype == bool and population.outlying.shape == (30,)
+    # Fewer subjects than G x G has dimensions: a singular covariance.
     with pytest.raises(ValueError, match="population_trend"):
-        bireg.population_trend(trends[:5], (0.0, 2.0), group="SO3")
+        bireg.population_trend(trends[:2 * g.dim - 1], (0.0, 2.0), group=group)
 
 
 def test_velocities_and_trends_at_one_covariate(rng):
@@ -394,8 +424,8 @@ def test_velocities_and_trends_at_one_covariate(rng):
     assert at_start.value == starts.value and at_start.p_value == starts.p_value
     with pytest.raises(ValueError, match="compare_velocities: .*t0 < t1"):
         bireg.compare_velocities(a, b, (2.0, 0.0), group="SO3")
-    with pytest.raises(ValueError, match="SO3, SE3"):
-        bireg.compare_trends_at(a, b, (0.0, 2.0), 1.0, group="SL3")
+    with pytest.raises(ValueError, match="unknown group 'SO4'"):
+        bireg.compare_trends_at(a, b, (0.0, 2.0), 1.0, group="SO4")
 
 
 def test_shares_of_a_test_join_only_when_they_are_one_test(rng):

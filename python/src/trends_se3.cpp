@@ -1,0 +1,4 @@
+// SE(3)'s trend functions, compiled alone (cohorts.hpp says why).
+#include "trend_group.hpp"
+
+template struct bireg_python::TrendFunctions<bireg::SE3d>;
