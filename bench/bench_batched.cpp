@@ -39,49 +39,23 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/regression.hpp"
 #include "bireg/regression/batched_force.hpp"
+#include "geodesic_problem.hpp"
 
 namespace {
 
-template <class G>
-struct Problem {
-  std::vector<typename G::Element> f;
-  std::vector<double> t;
-};
+using bench::InDouble;
+using bench::make_problem;
+using bench::Problem;
 
-// The same group in double precision.
-template <class G>
-struct InDouble;
-template <template <class> class Group, class Scalar>
-struct InDouble<Group<Scalar>> {
-  using type = Group<double>;
-};
-
-// bench_regression's make_problem: a geodesic of length `length` from a
-// random start, noise entries uniform in [-noise, noise]; drawn in double
-// and rounded to G's scalar, so that float and double fit the same data.
-template <class G>
-Problem<G> make_problem(int n, double length, double noise, unsigned seed) {
-  using D = typename InDouble<G>::type;
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  typename D::Tangent start, x;
-  for (int k = 0; k < D::dof; ++k) {
-    start[k] = uniform(rng);
-    x[k] = uniform(rng);
-  }
-  x *= length / x.norm();
-  const typename D::Element g0 = D::exp(start);
-  Problem<G> problem;
-  for (int i = 0; i < n; ++i) {
-    const double s = static_cast<double>(i) / (n - 1);
-    typename D::Tangent e;
-    for (int k = 0; k < D::dof; ++k)
-      e[k] = noise * uniform(rng);
-    const typename D::Element f = D::compose(D::compose(g0, D::exp(s * x)), D::exp(e));
-    problem.f.push_back(f.template cast<typename G::Scalar>());
-    problem.t.push_back(s);
-  }
-  return problem;
+// The label of a case: the instruction set the kernel was compiled for, or
+// the scalar loop.
+void label(benchmark::State& state, bool batched) {
+#if BIREG_HAS_BATCHED_FORCE
+  state.SetLabel(batched ? bireg::batched::target_name() : "scalar");
+#else
+  static_cast<void>(batched);
+  state.SetLabel("scalar (no batched kernel in this build)");
+#endif
 }
 
 template <class G>
@@ -100,11 +74,7 @@ void BM_Cost(benchmark::State& state) {
     iterations = result.iterations;
     benchmark::DoNotOptimize(result.geodesic);
   }
-#if BIREG_HAS_BATCHED_FORCE
-  state.SetLabel(batched ? bireg::batched::target_name() : "scalar");
-#else
-  state.SetLabel("scalar (no batched kernel in this build)");
-#endif
+  label(state, batched);
   state.counters["iterations"] = iterations;
   state.counters["time_per_obs_iter"] = benchmark::Counter(
       static_cast<double>(problem.f.size()) * iterations,
@@ -187,9 +157,7 @@ void BM_Trade(benchmark::State& state) {
   state.counters["endpoint_error"] =
       std::max(distance(reference.geodesic->start(), result.geodesic->start()),
                distance(reference.geodesic->end(), result.geodesic->end()));
-#if BIREG_HAS_BATCHED_FORCE
-  state.SetLabel(options.batched_kernels ? bireg::batched::target_name() : "scalar");
-#endif
+  label(state, options.batched_kernels);
 }
 void trade_arguments(benchmark::internal::Benchmark* benchmark) {
   benchmark->ArgNames({"source", "batched"})->ArgsProduct({{0, 1}, {0, 1}});
@@ -245,11 +213,7 @@ void BM_Force(benchmark::State& state) {
                                                                       residuals, nullptr, batched);
     benchmark::DoNotOptimize(force);
   }
-#if BIREG_HAS_BATCHED_FORCE
-  state.SetLabel(batched ? bireg::batched::target_name() : "scalar");
-#else
-  state.SetLabel("scalar (no batched kernel in this build)");
-#endif
+  label(state, batched);
   state.counters["time_per_obs"] = benchmark::Counter(
       static_cast<double>(data.f.size()),
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);

@@ -27,7 +27,6 @@
 // iterations), in seconds (printed with an SI prefix: 308n = 308 ns).
 #include <algorithm>
 #include <cstdio>
-#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,41 +41,12 @@
 #include "bireg/groups/sim3.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/regression.hpp"
+#include "geodesic_problem.hpp"
 
 namespace {
 
-template <class G>
-struct Problem {
-  std::vector<typename G::Element> f;
-  std::vector<double> t;
-};
-
-// N observations along a geodesic whose rotation part has length `length`
-// rad (translation part of comparable size), noise entries uniform in
-// [-noise, noise].
-template <class G>
-Problem<G> make_problem(int n, double length, double noise, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  typename G::Tangent start, x;
-  for (int k = 0; k < G::dof; ++k) {
-    start[k] = uniform(rng);
-    x[k] = uniform(rng);
-  }
-  x *= length / x.norm();
-  const typename G::Element g0 = G::exp(start);
-  Problem<G> problem;
-  problem.f.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const double s = static_cast<double>(i) / (n - 1);
-    typename G::Tangent e;
-    for (int k = 0; k < G::dof; ++k)
-      e[k] = noise * uniform(rng);
-    problem.f.push_back(G::compose(G::compose(g0, G::exp(s * x)), G::exp(e)));
-    problem.t.push_back(s);
-  }
-  return problem;
-}
+using bench::make_problem;
+using bench::Problem;
 
 template <class G>
 void run_fits(benchmark::State& state, const Problem<G>& problem,

@@ -240,9 +240,10 @@ HWY_INLINE Mask<Scalar> rotation_log(const Vec<Scalar> m[9], Vec<Scalar> omega[3
   const Vec<Scalar> one_plus_trace = one + trace;
   const Vec<Scalar> y = hn::Sqrt(d0 * d0 + d1 * d1 + d2 * d2) / one_plus_trace;
   const Vec<Scalar> tiny = hn::Set(d, small_angle::tiny_angle<Scalar>());
-  const Vec<Scalar> third = hn::Set(d, Scalar(1) / Scalar(3));
-  const Vec<Scalar> atan_over_y =
-      hn::IfThenElse(hn::Lt(hn::Abs(y), tiny), one - y * y * third, hn::Atan(d, y) / y);
+  const Vec<Scalar> three = hn::Set(d, Scalar(3));
+  // small_angle::atan_over_y: 1 - y^2 / 3 below tiny_angle, divided as there.
+  const Vec<Scalar> atan_over_y = hn::IfThenElse(
+      hn::Lt(hn::Abs(y), tiny), hn::Sub(one, hn::Div(y * y, three)), hn::Atan(d, y) / y);
   const Vec<Scalar> factor = two / one_plus_trace * atan_over_y;
   omega[0] = factor * d0;
   omega[1] = factor * d1;
@@ -473,16 +474,12 @@ inline const char* target_name() {
   return hwy::TargetName(HWY_STATIC_TARGET);
 }
 
-// The number of observations per vector.
-template <class Scalar>
-std::size_t lanes() {
-  return detail::hn::Lanes(detail::Tag<Scalar>());
-}
-
 // SO(3): the sums of observations [begin, end) at g0^{-1} = g0_inverse and
 // X prepared in both directions (ClosedFormPsi::prepare(x) and (-x), theta
-// in [kExactMinAngle, pi]), writing each residual into residuals[i]; t and
-// w are the problem's covariates on [0, 1] and weights.
+// at least kExactMinAngle: up to pi by the difference formulas, beyond pi
+// with both half angles evaluated directly, as half_angles), writing each
+// residual into residuals[i]; t and w are the problem's covariates on
+// [0, 1] and weights.
 template <class Scalar, class Observations>
 ForceSums<SO3<Scalar>> closed_form_sums(
     const SO3<Scalar>&, const Observations& observations, const Scalar* t_values,
