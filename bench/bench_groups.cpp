@@ -13,6 +13,7 @@
 #include <benchmark/benchmark.h>
 #include <Eigen/Geometry>
 
+#include "bireg/groups/element_check.hpp"
 #include "bireg/groups/se2.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/sim3.hpp"
@@ -161,5 +162,54 @@ void BM_SE3Exp(benchmark::State& state) {
 BENCHMARK(BM_SE3Exp);
 
 }  // namespace
+
+// Membership of 256 row-major matrices in cache (numpy's layout, as the
+// Python module checks them before a batched log): G::is_element matrix by
+// matrix, against first_non_element's block loop (groups/element_check.hpp),
+// which the compiler vectorizes across matrices when the target can gather
+// (build with -march=haswell or -march=skylake-avx512 to see it). Per matrix.
+template <class G>
+std::vector<double> row_major_elements(int count) {
+  using RowMajor = Eigen::Matrix<double, G::Element::RowsAtCompileTime,
+                                 G::Element::ColsAtCompileTime, Eigen::RowMajor>;
+  const auto xs = sample_tangents<G>(count);
+  std::vector<double> data(xs.size() * RowMajor::SizeAtCompileTime);
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    Eigen::Map<RowMajor> target(data.data() + i * RowMajor::SizeAtCompileTime);
+    target = G::exp(xs[i]);
+  }
+  return data;
+}
+
+template <class G>
+void BM_IsElementEach(benchmark::State& state) {
+  using RowMajor = Eigen::Matrix<double, G::Element::RowsAtCompileTime,
+                                 G::Element::ColsAtCompileTime, Eigen::RowMajor>;
+  const std::vector<double> data = row_major_elements<G>(256);
+  for (auto _ : state) {
+    std::size_t members = 0;
+    while (members < 256 && G::is_element(typename G::Element(Eigen::Map<const RowMajor>(
+                                data.data() + members * RowMajor::SizeAtCompileTime))))
+      ++members;
+    benchmark::DoNotOptimize(members);
+  }
+  state.SetItemsProcessed(state.iterations() * 256);
+}
+
+template <class G>
+void BM_FirstNonElement(benchmark::State& state) {
+  const std::vector<double> data = row_major_elements<G>(256);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(data.data());
+    const std::size_t members = bireg::first_non_element<G>(data.data(), 256);
+    benchmark::DoNotOptimize(members);
+  }
+  state.SetItemsProcessed(state.iterations() * 256);
+}
+
+BENCHMARK_TEMPLATE(BM_IsElementEach, bireg::SO3<double>);
+BENCHMARK_TEMPLATE(BM_FirstNonElement, bireg::SO3<double>);
+BENCHMARK_TEMPLATE(BM_IsElementEach, bireg::SE3<double>);
+BENCHMARK_TEMPLATE(BM_FirstNonElement, bireg::SE3<double>);
 
 BENCHMARK_MAIN();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <nanobind/stl/optional.h>
@@ -12,6 +13,7 @@
 #include "common.hpp"
 
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/groups/element_check.hpp"
 #include "bireg/groups/tolerance.hpp"
 
 namespace bireg_python {
@@ -52,22 +54,68 @@ void map_tangents(const Matrix& x, std::size_t rows, std::size_t cols, double* o
   if (bad >= 0) refuse_at(std::string(what) + ": the tangent vector is not finite at index", bad);
 }
 
+// Asks the cache for the `count` numbers from `p` on (a hint: an address
+// outside the array is not read).
+inline void prefetch(const double* p, std::size_t count) {
+  constexpr std::size_t kLine = 64 / sizeof(double);
+  for (std::size_t k = 0; k < count; k += kLine)
+    __builtin_prefetch(p + k);
+  __builtin_prefetch(p + count - 1);
+}
+
 // Elements per block of map_elements: 256 SE(3) matrices are 32 KiB, so a
 // block checked is still in cache when f reads it.
 constexpr std::size_t kElementBlock = 256;
+
+// bireg::first_non_element for the CPU this runs on. SO(3)'s and SE(3)'s
+// check vectorizes across matrices where the target can gather, and the
+// module is built for the baseline, so with GCC on x86-64 Linux these two
+// are compiled for AVX-512, AVX2 and the baseline and the loader picks one
+// (target_clones, an ifunc); an SE(3) matrix in cache takes 4.9, 5.6 and
+// 8.2 ns (groups/element_check.hpp). Raw numbers in, an index out: no Eigen
+// object crosses between code built for different vector widths.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+__attribute__((target_clones("avx512f", "avx2", "default"), flatten))
+#endif
+std::size_t
+first_non_rotation(const double* data, std::size_t count, double tol) {
+  return bireg::first_non_element<bireg::SO3d>(data, count, tol);
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+__attribute__((target_clones("avx512f", "avx2", "default"), flatten))
+#endif
+std::size_t
+first_non_pose(const double* data, std::size_t count, double tol) {
+  return bireg::first_non_element<bireg::SE3d>(data, count, tol);
+}
+
+template <class G>
+std::size_t first_non_element(const double* data, std::size_t count, double tol) {
+  if constexpr (std::is_same_v<G, bireg::SO3d>) {
+    return first_non_rotation(data, count, tol);
+  } else if constexpr (std::is_same_v<G, bireg::SE3d>) {
+    return first_non_pose(data, count, tol);
+  } else {
+    return bireg::first_non_element<G>(data, count, tol);
+  }
+}
 
 // f of each element of the stack, written row-major at `out`, `stride`
 // numbers per element; refuses, with `refusal` and the index, the first
 // matrix that is not an element of G (is_element: finite, and in G to the
 // default tolerance) or whose f is not finite. A block is checked in a loop
-// of its own, then mapped: over 1e6 SE(3) logs this took 10 ms less than
-// checking each element just before its log, and reading each matrix
-// twice (row-major into the group's Element) was faster than keeping the
-// block's Elements for the second loop (bench/README.md).
+// of its own (first_non_element), then mapped: over 1e6 SE(3) logs this
+// took 10 ms less than checking each element just before its log, and
+// reading each matrix twice (row-major into the group's Element) was faster
+// than keeping the block's Elements for the second loop. While a block is
+// mapped the next one is fetched, so that its check reads the cache: the
+// check alone is too light to hide memory's latency (3.5 ms of 73 over 1e6
+// SE(3) logs; bench/README.md, "Python against C++").
 template <class G, class F>
 void map_elements(const Stack& g, std::size_t stride, double* out, const std::string& refusal,
                   F f) {
-  const std::size_t count = g.shape(0);
+  const std::size_t count = g.shape(0), entries = std::size_t(side<G>() * side<G>());
   const StackView<G> elements(g);
   const double tolerance = bireg::default_element_tolerance<double>();
   std::ptrdiff_t bad = -1;
@@ -77,10 +125,10 @@ void map_elements(const Stack& g, std::size_t stride, double* out, const std::st
       // The block's elements up to the first that is not one; those are
       // mapped first, so that an earlier f that is not finite is named.
       const std::size_t end = std::min(count, begin + kElementBlock);
-      std::size_t members = begin;
-      while (members < end && G::is_element(elements[members], tolerance))
-        ++members;
+      const std::size_t members =
+          begin + first_non_element<G>(g.data() + begin * entries, end - begin, tolerance);
       for (std::size_t i = begin; i < members && bad < 0; ++i) {
+        if (i + kElementBlock < count) prefetch(g.data() + (i + kElementBlock) * entries, entries);
         const auto value = f(elements[i]);
         if (!value.allFinite()) bad = std::ptrdiff_t(i);
         write_row_major(value, out + i * stride);

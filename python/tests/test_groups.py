@@ -117,6 +117,29 @@ def test_out_is_checked_and_refusals_still_name_the_index(rng):
         bireg.SE3.log(e, out=np.empty((5, 6)))
 
 
+@pytest.mark.parametrize("group", ["SO3", "SE3"])
+def test_log_names_the_first_non_element_at_and_across_block_edges(group, rng):
+    # SO3's and SE3's membership is checked 256 matrices at a time, by code
+    # compiled for the CPU's vector width (groups/element_check.hpp): every
+    # defect is found wherever it lies, and the first of two is named.
+    g = bireg.groups.get(group)
+    good = g.exp(rng.uniform(-1.5, 1.5, (1000, g.dim)))
+    assert np.isfinite(g.log(good)).all()
+    defects = [(0, 1, 1e-3), (2, 2, np.nan), (1, 0, np.inf)]
+    if group == "SE3":
+        defects += [(3, 1, 1e-3), (3, 3, 1.001), (0, 3, np.nan)]
+    for index in (0, 255, 256, 257, 999):
+        for r, c, value in defects:
+            bad = good.copy()
+            bad[index, r, c] = bad[index, r, c] + value if value == 1e-3 else value
+            with pytest.raises(ValueError, match=f"at index {index}$"):
+                g.log(bad)
+            if index < 999:
+                bad[999, 0, 0] = np.nan
+                with pytest.raises(ValueError, match=f"at index {index}$"):
+                    g.log(bad, out=np.empty((1000, g.dim)))
+
+
 def test_the_first_failure_is_named_and_the_module_refuses_an_out_it_would_copy(rng):
     # diag(-1, -1, 1) is in GL+(3) but has no principal log; the NaN matrix
     # after it is not an element. The first of the two is named.
