@@ -73,6 +73,10 @@ int explog(const char* path, int repeats) {
     raw.insert(raw.end(), buffer, buffer + 6);
   std::fclose(file);
   const std::size_t n = raw.size() / 6;
+  if (n == 0) {
+    std::fprintf(stderr, "bench_python_reference: %s holds no 6-vector\n", path);
+    return 2;
+  }
   std::vector<G::Element> elements(n);
   std::vector<G::Tangent> logs(n);
   const double exp_seconds = median_seconds(repeats, [&] {

@@ -20,7 +20,8 @@ fastest process of each. On the development VM a whole process, C++ or
 Python, runs either at full speed or 25-35 % slower throughout (the same
 binary and data; not the core, the alignment or huge pages), so a ratio of
 two single processes can measure that draw instead of the overhead; the
-fastest of each compares the two at full speed.
+fastest of each compares the two at full speed. The scipy comparison runs
+in this process: both sides are Python.
 """
 
 import argparse

@@ -11,8 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <nanobind/stl/vector.h>
-
 #include "common.hpp"
 #include "fit_handle.hpp"
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import bireg
+from conftest import GROUP_NAMES
 
 linalg = pytest.importorskip("scipy.linalg")
 
@@ -314,12 +315,9 @@ def test_fit_many_refuses_when_a_subject_fails(rng):
         bireg.fit_many(subjects[:2], group="SO3", interval=(1.0, 0.0))
 
 
-TREND_GROUPS = ["SO2", "SO3", "SE2", "SE3", "Sim3", "SL3", "GLp3"]
-
-
 def trend_velocities(group):
-    """Two cohorts' mean velocities, 0.2 per unit apart in the first
-    coordinate (for SO3: (0.4, 0, 0.1) and (0.4, 0.2, 0.1))."""
+    """Two cohorts' mean velocities, 0.2 per unit apart in one coordinate
+    (for SO3 the second: (0.4, 0, 0.1) and (0.4, 0.2, 0.1); else the first)."""
     if group == "SO3":
         return np.array([0.4, 0.0, 0.1]), np.array([0.4, 0.2, 0.1])
     dim = bireg.groups.get(group).dim
@@ -327,7 +325,7 @@ def trend_velocities(group):
     return a, a + 0.2 * np.eye(dim)[0]
 
 
-@pytest.mark.parametrize("group", TREND_GROUPS)
+@pytest.mark.parametrize("group", GROUP_NAMES)
 def test_compare_trends_equals_the_test_on_block_diagonal_pairs(group, rng):
     g = bireg.groups.get(group)
     n = g.matrix_size
@@ -355,8 +353,12 @@ def test_compare_trends_equals_the_test_on_block_diagonal_pairs(group, rng):
     # bireg's means (chord steps, two_sample.hpp's split_mean) stop once a
     # step is at most MeanOptions' tolerance, 1e-10, so each is within about
     # 1e-10 of the root found here to 1e-15; c moves by up to 2e-10, and T^2,
-    # quadratic in c, by up to 2 * 2e-10 / |c| relative (the covariances'
-    # share is smaller: residuals of size ~0.05 move by 1e-10).
+    # quadratic in c, by up to 2 * 2e-10 / |c| relative. The covariances
+    # change only to second order: at the mean the residuals sum to zero,
+    # so moving it shifts them all alike and their scatter matrix by the
+    # square of the shift. (|c| here is Euclidean in this basis, not the
+    # pooled covariance's norm: an estimate, not a bound; the errors seen
+    # were at most a third of it.)
     assert result.value == pytest.approx(t2, rel=4e-10 / np.linalg.norm(c))
     if group == "SO3":
         # A velocity that differs by 0.2 rad/unit, four between-subject
@@ -366,7 +368,7 @@ def test_compare_trends_equals_the_test_on_block_diagonal_pairs(group, rng):
         assert same.p_value > 0.01
 
 
-@pytest.mark.parametrize("group", TREND_GROUPS)
+@pytest.mark.parametrize("group", GROUP_NAMES)
 def test_population_trend_against_its_definition(group, rng):
     g = bireg.groups.get(group)
     start, velocity = g.exp(np.linspace(0.3, 0.1, g.dim)), np.linspace(0.2, -0.3, g.dim)
@@ -386,9 +388,30 @@ def test_population_trend_against_its_definition(group, rng):
     m0, m1 = population.mean
     assert np.allclose(population.velocity, g.log(np.linalg.solve(m0, m1)) / 2.0, atol=1e-12)
     assert population.outlying.dtype == bool and population.outlying.shape == (30,)
-    # Fewer subjects than G x G has dimensions: a singular covariance.
+    # 2 dim - 1 subjects, fewer than G x G has dimensions: refused (a
+    # singular covariance; for SO2, one subject, too few for any).
     with pytest.raises(ValueError, match="population_trend"):
         bireg.population_trend(trends[:2 * g.dim - 1], (0.0, 2.0), group=group)
+
+
+@pytest.mark.parametrize("group", GROUP_NAMES)
+def test_trends_at_one_covariate_and_velocities_in_every_group(group, rng):
+    # At t0 the test of the trends' elements is the test of their starts;
+    # the velocities' means are the means of log(g0^-1 g1) / (t1 - t0).
+    g = bireg.groups.get(group)
+    start = g.exp(np.linspace(0.2, -0.1, g.dim))
+    v_a, v_b = trend_velocities(group)
+    a = bireg.fit_many(subjects_about(start, v_a, 2 * g.dim + 4, rng, group=group), group=group,
+                       interval=(0.0, 2.0)).trends
+    b = bireg.fit_many(subjects_about(start, v_b, 2 * g.dim + 6, rng, group=group), group=group,
+                       interval=(0.0, 2.0)).trends
+    at_start = bireg.compare_trends_at(a, b, (0.0, 2.0), 0.0, group=group, permutations=99)
+    starts = bireg.two_sample_test(a[:, 0], b[:, 0], group=group, permutations=99)
+    assert at_start.value == starts.value and at_start.p_value == starts.p_value
+    velocities = bireg.compare_velocities(a, b, (0.0, 2.0), group=group, permutations=99)
+    own = g.log(np.linalg.solve(a[:, 0], a[:, 1])) / 2.0
+    assert velocities.mean_a.shape == (g.dim,)
+    assert np.allclose(velocities.mean_a, own.mean(0), atol=1e-12)
 
 
 def test_velocities_and_trends_at_one_covariate(rng):

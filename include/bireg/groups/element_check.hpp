@@ -9,16 +9,16 @@
 // evaluated for a block of matrices before any verdict is read: a loop
 // without branches, which a compiler vectorizes across matrices where the
 // target can gather (AVX2, AVX-512). Per SE(3) matrix in cache, on the
-// 2-core AMD EPYC VM (GCC 12, 2026-11-29, bench_groups): is_element one by
-// one 11.6 ns; this loop 8.2 ns for x86-64, 5.6 for Haswell, 4.9 for
-// Skylake-AVX512 (SO(3): 13.6 against 6.1, 5.0, 4.9). A caller that wants
-// the vector width of the CPU it runs on compiles its call once per target
-// (the Python module does, with GCC's target_clones).
+// 2-core AMD EPYC VM (GCC 12, 2026-11-29, bench_groups built with no -march,
+// -march=haswell and -march=skylake-avx512): is_element one by one 11.6 ns;
+// this loop 8.2, 5.6 and 4.9 ns (SO(3): 13.6 against 6.1, 5.0, 4.9). A
+// caller that wants the vector width of the CPU it runs on compiles its
+// call once per target (the Python module does, with GCC's target_clones).
 //
-// The departures are the same sums as is_rotation's, but a compiler may
-// contract them into fused multiply-adds differently from one target to
-// another: a matrix within a rounding error of the tolerance may be judged
-// either way. An infinite tolerance takes is_element itself, which then
+// The departures are is_rotation's sums up to the order of their terms, and
+// a compiler may contract them into fused multiply-adds differently from
+// one target to another: a matrix within a rounding error of the tolerance
+// may be judged either way. An infinite tolerance takes is_element itself, which then
 // checks finiteness apart.
 #pragma once
 
@@ -93,6 +93,9 @@ std::size_t first_non_element(
     typename G::Scalar tol = default_element_tolerance<typename G::Scalar>()) {
   using Scalar = typename G::Scalar;
   using Element = typename G::Element;
+  static_assert(
+      Element::RowsAtCompileTime == Element::ColsAtCompileTime && Element::RowsAtCompileTime > 0,
+      "first_non_element: G's elements must be square matrices of a fixed size");
   constexpr int kSide = int(Element::RowsAtCompileTime);
   constexpr std::size_t kEntries = std::size_t(kSide) * std::size_t(kSide);
   using RowMajor = Eigen::Matrix<Scalar, kSide, kSide, Eigen::RowMajor>;
