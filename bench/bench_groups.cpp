@@ -161,6 +161,11 @@ void BM_SE3Exp(benchmark::State& state) {
 }
 BENCHMARK(BM_SE3Exp);
 
+// G's elements as numpy stores them, row-major.
+template <class G>
+using RowMajor = Eigen::Matrix<double, G::Element::RowsAtCompileTime, G::Element::ColsAtCompileTime,
+                               Eigen::RowMajor>;
+
 // Membership of 256 row-major matrices in cache (numpy's layout, as the
 // Python module checks them before a batched log): G::is_element matrix by
 // matrix, against first_non_element's block loop (groups/element_check.hpp),
@@ -168,12 +173,10 @@ BENCHMARK(BM_SE3Exp);
 // (build with -march=haswell or -march=skylake-avx512 to see it). Per matrix.
 template <class G>
 std::vector<double> row_major_elements(int count) {
-  using RowMajor = Eigen::Matrix<double, G::Element::RowsAtCompileTime,
-                                 G::Element::ColsAtCompileTime, Eigen::RowMajor>;
   const auto xs = sample_tangents<G>(count);
-  std::vector<double> data(xs.size() * RowMajor::SizeAtCompileTime);
+  std::vector<double> data(xs.size() * RowMajor<G>::SizeAtCompileTime);
   for (std::size_t i = 0; i < xs.size(); ++i) {
-    Eigen::Map<RowMajor> target(data.data() + i * RowMajor::SizeAtCompileTime);
+    Eigen::Map<RowMajor<G>> target(data.data() + i * RowMajor<G>::SizeAtCompileTime);
     target = G::exp(xs[i]);
   }
   return data;
@@ -181,14 +184,12 @@ std::vector<double> row_major_elements(int count) {
 
 template <class G>
 void BM_IsElementEach(benchmark::State& state) {
-  using RowMajor = Eigen::Matrix<double, G::Element::RowsAtCompileTime,
-                                 G::Element::ColsAtCompileTime, Eigen::RowMajor>;
   const std::vector<double> data = row_major_elements<G>(256);
   for (auto _ : state) {
     benchmark::DoNotOptimize(data.data());
     std::size_t members = 0;
-    while (members < 256 && G::is_element(typename G::Element(Eigen::Map<const RowMajor>(
-                                data.data() + members * RowMajor::SizeAtCompileTime))))
+    while (members < 256 && G::is_element(typename G::Element(Eigen::Map<const RowMajor<G>>(
+                                data.data() + members * RowMajor<G>::SizeAtCompileTime))))
       ++members;
     benchmark::DoNotOptimize(members);
   }

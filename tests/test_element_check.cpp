@@ -2,12 +2,13 @@
 // row-major matrix that G::is_element refuses, for SO(3) and SE(3) by the
 // straight-line block loop and for other groups by is_element itself.
 //
-// What must hold: the verdict is is_element's. The block loop computes the
-// same departures in another order of operations, so a matrix within a
-// rounding error of the tolerance may be judged either way; the comparison
-// on random near-elements skips the few whose is_element verdict changes
-// when the tolerance moves by 1e-6 of itself (far more than the rounding of
-// a sum of three products of entries of size 1, a few 1e-16).
+// What must hold: the verdict is is_element's. The block loop evaluates the
+// same functions of the entries (groups/membership.hpp), but a compiler may
+// contract them into fused multiply-adds differently there and in is_element,
+// so a matrix within a rounding error of the tolerance may be judged either
+// way; the comparison on random near-elements skips the few whose is_element
+// verdict changes when the tolerance moves by 1e-6 of itself (far more than the
+// rounding of a sum of three products of entries of size 1, a few 1e-16).
 //
 // The block loop is written to be vectorized across matrices, so this file
 // is also built with -march=haswell and -march=skylake-avx512

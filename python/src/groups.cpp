@@ -63,10 +63,6 @@ inline void prefetch(const double* p, std::size_t count) {
   if ((count - 1) % kLine != 0) __builtin_prefetch(p + count - 1);
 }
 
-// Elements per block of map_elements: 256 SE(3) matrices are 32 KiB, so a
-// block checked is still in cache when f reads it.
-constexpr std::size_t kElementBlock = 256;
-
 // bireg::first_non_element for the CPU this runs on. SO(3)'s and SE(3)'s
 // check vectorizes across matrices where the target can gather, and the
 // module is built for the baseline, so with GCC on x86-64 and glibc these
@@ -104,17 +100,18 @@ std::size_t first_non_element(const double* data, std::size_t count, double tol)
   }
 }
 
-// f of each element of the stack, written row-major at `out`, `stride`
-// numbers per element; refuses, with `refusal` and the index, the first
-// matrix that is not an element of G (is_element: finite, and in G to the
-// default tolerance) or whose f is not finite. A block is checked in a loop
-// of its own (first_non_element), then mapped: over 1e6 SE(3) logs this
-// took 10 ms less than checking each element just before its log, and
+// f of each element of the stack, written row-major at `out`, `stride` numbers
+// per element; refuses, with `refusal` and the index, the first matrix that is
+// not an element of G (is_element: finite, and in G to the default tolerance)
+// or whose f is not finite. A block (first_non_element's own,
+// bireg::kElementCheckBlock = 256 matrices: 32 KiB of SE(3), still in cache
+// when f reads it) is checked in a loop of its own, then mapped: over 1e6 SE(3)
+// logs this took 10 ms less than checking each element just before its log, and
 // reading each matrix twice (row-major into the group's Element) was faster
 // than keeping the block's Elements for the second loop. While a block is
-// mapped the next one is fetched, so that its check reads the cache: the
-// check alone is too light to hide memory's latency (3.5 ms of 73 over 1e6
-// SE(3) logs; bench/README.md, "Python against C++").
+// mapped the next one is fetched, so that its check reads the cache: the check
+// alone is too light to hide memory's latency (3.5 ms of 73 over 1e6 SE(3)
+// logs; bench/README.md, "Python against C++").
 template <class G, class F>
 void map_elements(const Stack& g, std::size_t stride, double* out, const std::string& refusal,
                   F f) {
@@ -124,14 +121,15 @@ void map_elements(const Stack& g, std::size_t stride, double* out, const std::st
   std::ptrdiff_t bad = -1;
   {
     nb::gil_scoped_release release;
-    for (std::size_t begin = 0; begin < count && bad < 0; begin += kElementBlock) {
+    for (std::size_t begin = 0; begin < count && bad < 0; begin += bireg::kElementCheckBlock) {
       // The block's elements up to the first that is not one; those are
       // mapped first, so that an earlier f that is not finite is named.
-      const std::size_t end = std::min(count, begin + kElementBlock);
+      const std::size_t end = std::min(count, begin + bireg::kElementCheckBlock);
       const std::size_t members =
           begin + first_non_element<G>(g.data() + begin * entries, end - begin, tolerance);
       for (std::size_t i = begin; i < members && bad < 0; ++i) {
-        if (i + kElementBlock < count) prefetch(g.data() + (i + kElementBlock) * entries, entries);
+        if (i + bireg::kElementCheckBlock < count)
+          prefetch(g.data() + (i + bireg::kElementCheckBlock) * entries, entries);
         const auto value = f(elements[i]);
         if (!value.allFinite()) bad = std::ptrdiff_t(i);
         write_row_major(value, out + i * stride);

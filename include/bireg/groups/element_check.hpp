@@ -4,22 +4,24 @@
 // or count when every one is an element.
 //
 // For SO(3) and SE(3) the tests of is_element (SO3::is_rotation's seven
-// departures of R^T R from I and of det R from 1, SE(3)'s last row, all
-// finite) are written out as straight-line arithmetic on the entries and
-// evaluated for a block of matrices before any verdict is read: a loop
-// without branches, which a compiler vectorizes across matrices where the
-// target can gather (AVX2, AVX-512). Per SE(3) matrix in cache, on the
-// 2-core AMD EPYC VM (GCC 12, 2026-11-29, bench_groups built with no -march,
-// -march=haswell and -march=skylake-avx512): is_element one by one 11.6 ns;
-// this loop 8.2, 5.6 and 4.9 ns (SO(3): 13.6 against 6.1, 5.0, 4.9). A
-// caller that wants the vector width of the CPU it runs on compiles its
-// call once per target (the Python module does, with GCC's target_clones).
+// departures of R^T R from I and of det R from 1, SE(3)'s last row, a finite
+// translation) are straight-line arithmetic on the entries
+// (groups/membership.hpp), here evaluated for a block of matrices before any
+// verdict is read: a loop without branches, which a compiler vectorizes across
+// matrices where the target can gather (AVX2, AVX-512). Per matrix in cache, on
+// the 2-core AMD EPYC VM (GCC 12, 2026-11-29, bench_groups built with no
+// -march, -march=haswell and -march=skylake-avx512): SE(3), this loop 8.0, 5.6
+// and 5.0 ns against is_element one by one 10.1, 10.3 and 10.6; SO(3), 6.1, 4.8
+// and 5.0 against 4.5 to 5.7, so the loop gains on SE(3) only (is_element took
+// 11.6 and 13.6 ns before it shared this arithmetic). A caller that wants the
+// vector width of the CPU it runs on compiles its call once per target (the
+// Python module does, with GCC's target_clones).
 //
-// The departures are is_rotation's sums up to the order of their terms, and
-// a compiler may contract them into fused multiply-adds differently from
-// one target to another: a matrix within a rounding error of the tolerance
-// may be judged either way. An infinite tolerance takes is_element itself, which then
-// checks finiteness apart.
+// The departures are those of is_element, computed by the same functions;
+// only a compiler's contraction of them into fused multiply-adds may differ
+// from one target (or one inlining) to another, so a matrix within a
+// rounding error of the tolerance may be judged either way. An infinite
+// tolerance takes is_element itself, which then checks finiteness apart.
 #pragma once
 
 #include <algorithm>
@@ -30,52 +32,30 @@
 
 #include <Eigen/Core>
 
+#include "bireg/groups/membership.hpp"
 #include "bireg/groups/se3.hpp"
 #include "bireg/groups/so3.hpp"
 
 namespace bireg {
 
+// Matrices per block of first_non_element: 256 SE(3) matrices are 32 KiB.
+// A caller that checks a long array block by block (the Python module's
+// batched maps) may use the same number.
+inline constexpr std::size_t kElementCheckBlock = 256;
+
 namespace element_check_detail {
-
-// Matrices per block: 256 SE(3) matrices are 32 KiB.
-inline constexpr std::size_t kBlock = 256;
-
-// 1 when |x| <= tol, else 0 (also for NaN): an integer, so that the block
-// loop stays in one element width.
-template <class Scalar>
-inline std::int64_t small(Scalar x, Scalar tol) {
-  using std::abs;
-  return abs(x) <= tol;
-}
-
-// SO3::is_rotation of the 3 x 3 block whose first entry is at `r`, with
-// `stride` numbers between rows: R^T R - I by the columns' dot products,
-// det R - 1 as c0 . (c1 x c2) - 1.
-template <class Scalar>
-inline std::int64_t rotation_within(const Scalar* r, std::size_t stride, Scalar tol) {
-  const Scalar a0 = r[0], a1 = r[stride], a2 = r[2 * stride];
-  const Scalar b0 = r[1], b1 = r[stride + 1], b2 = r[2 * stride + 1];
-  const Scalar c0 = r[2], c1 = r[stride + 2], c2 = r[2 * stride + 2];
-  const Scalar det = a0 * (b1 * c2 - b2 * c1) + a1 * (b2 * c0 - b0 * c2) + a2 * (b0 * c1 - b1 * c0);
-  return small(a0 * a0 + a1 * a1 + a2 * a2 - 1, tol) & small(b0 * b0 + b1 * b1 + b2 * b2 - 1, tol) &
-         small(c0 * c0 + c1 * c1 + c2 * c2 - 1, tol) & small(a0 * b0 + a1 * b1 + a2 * b2, tol) &
-         small(a0 * c0 + a1 * c1 + a2 * c2, tol) & small(b0 * c0 + b1 * c1 + b2 * c2, tol) &
-         small(det - 1, tol);
-}
 
 // SO(3): the rotation alone.
 template <class Scalar>
 inline std::int64_t within(const SO3<Scalar>&, const Scalar* m, Scalar tol) {
-  return rotation_within(m, 3, tol);
+  return membership_detail::rotation_within(m, 3, tol);
 }
 
 // SE(3): the rotation block, the last row (0, 0, 0, 1) and a finite
-// translation (x - x is 0 for a finite x, NaN otherwise).
+// translation.
 template <class Scalar>
 inline std::int64_t within(const SE3<Scalar>&, const Scalar* m, Scalar tol) {
-  return rotation_within(m, 4, tol) & small(m[12], tol) & small(m[13], tol) & small(m[14], tol) &
-         small(m[15] - 1, tol) & small(m[3] - m[3], tol) & small(m[7] - m[7], tol) &
-         small(m[11] - m[11], tol);
+  return membership_detail::pose_within(m, tol);
 }
 
 template <class G>
@@ -103,9 +83,9 @@ std::size_t first_non_element(
   const bool finite_tolerance = abs(tol) <= std::numeric_limits<Scalar>::max();
   if constexpr (element_check_detail::kStraightLine<G>) {
     if (finite_tolerance) {
-      std::int64_t verdicts[element_check_detail::kBlock];
-      for (std::size_t begin = 0; begin < count; begin += element_check_detail::kBlock) {
-        const std::size_t size = std::min(element_check_detail::kBlock, count - begin);
+      std::int64_t verdicts[kElementCheckBlock];
+      for (std::size_t begin = 0; begin < count; begin += kElementCheckBlock) {
+        const std::size_t size = std::min(kElementCheckBlock, count - begin);
         const Scalar* block = data + begin * kEntries;
         for (std::size_t i = 0; i < size; ++i)
           verdicts[i] = element_check_detail::within(G{}, block + i * kEntries, tol);

@@ -20,6 +20,7 @@
 
 #include "bireg/groups/affine.hpp"
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/groups/membership.hpp"
 #include "bireg/groups/so3.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/psi_closed_form.hpp"
@@ -163,20 +164,20 @@ struct SE3 {
     return basis;
   }
 
-  // Rotation block in SO(3) (SO3::is_rotation, read in place) and last row
-  // (0, 0, 0, 1), to within tol (max-norm), all finite. Without branches,
-  // as SO3's: a NaN fails every comparison.
+  // Rotation block in SO(3) (SO3::is_rotation, read in place), last row
+  // (0, 0, 0, 1) to within tol (max-norm) and finite translation
+  // (membership_detail::pose_rest_within): the straight-line tests of
+  // groups/membership.hpp that first_non_element's block loop evaluates,
+  // combined without branches, so that a NaN fails every comparison.
   static bool is_element(const Element& g, Scalar tol = default_element_tolerance<Scalar>()) {
     using std::abs;
     const bool rotation = Rotation::is_rotation(g.template topLeftCorner<3, 3>(), tol);
-    const Eigen::Matrix<Scalar, 1, 4> last_row_departure =
-        g.template bottomRows<1>() - Eigen::Matrix<Scalar, 1, 4>(0, 0, 0, 1);
-    const bool last_row = (last_row_departure.array().abs() <= tol).all();
-    const bool finite_translation = g.template topRightCorner<3, 1>().allFinite();
+    const bool rest = membership_detail::pose_rest_within<Scalar>(
+        g(0, 3), g(1, 3), g(2, 3), g(3, 0), g(3, 1), g(3, 2), g(3, 3), tol);
     // An infinite tol passes an infinite entry of the last row.
     const bool finite_last_row =
         abs(tol) <= std::numeric_limits<Scalar>::max() || g.template bottomRows<1>().allFinite();
-    return rotation & last_row & finite_translation & finite_last_row;
+    return rotation & rest & finite_last_row;
   }
 
   // psi_s(ad_x) r in closed form (math/psi_closed_form.hpp; DESIGN.md section 2,

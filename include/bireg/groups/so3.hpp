@@ -20,6 +20,7 @@
 #include <Eigen/Geometry>  // cross()
 
 #include "bireg/groups/capabilities.hpp"
+#include "bireg/groups/membership.hpp"
 #include "bireg/groups/tolerance.hpp"
 #include "bireg/math/ad_algebra.hpp"
 #include "bireg/math/psi_closed_form.hpp"
@@ -253,24 +254,19 @@ struct SO3 {
   }
 
   // The same for any 3 x 3 expression (SE(3)'s rotation block, read in
-  // place). R^T R - I is symmetric: its six distinct entries are the
-  // columns' dot products, and det R = c0 . (c1 x c2). The seven tests are
-  // combined without branches: a NaN or an infinity anywhere makes a dot
-  // product NaN or infinite and its test false, so finiteness needs no scan
-  // of its own (unless tol is infinite), and the check costs little more
-  // than reading the matrix (bench/README.md, "Python against C++").
+  // place): the nine entries go to membership_detail::rotation_within
+  // (groups/membership.hpp), the straight-line arithmetic that
+  // first_non_element's block loop also evaluates. Its seven tests, R^T R -
+  // I by the columns' dot products and det R - 1 = c0 . (c1 x c2) - 1, are
+  // combined without branches: a NaN or an infinity anywhere makes a
+  // departure NaN or infinite and its test false, so finiteness needs no
+  // scan of its own unless tol is infinite.
   template <class Derived>
   static bool is_rotation(const Eigen::MatrixBase<Derived>& r, Scalar tol) {
+    EIGEN_STATIC_ASSERT_MATRIX_SPECIFIC_SIZE(Derived, 3, 3)
     using std::abs;
-    const auto c0 = r.col(0), c1 = r.col(1), c2 = r.col(2);
-    const Scalar departures[7] = {
-        c0.dot(c0) - 1, c1.dot(c1) - 1, c2.dot(c2) - 1,          c0.dot(c1),
-        c0.dot(c2),     c1.dot(c2),     c0.dot(c1.cross(c2)) - 1};
-    bool within = true;
-    for (const Scalar d : departures) {
-      const bool small = abs(d) <= tol;
-      within = within & small;
-    }
+    const bool within = membership_detail::rotation_within<Scalar>(
+        r(0, 0), r(1, 0), r(2, 0), r(0, 1), r(1, 1), r(2, 1), r(0, 2), r(1, 2), r(2, 2), tol);
     // An infinite tol passes an infinite departure: then finiteness is
     // checked apart.
     const bool finite_tolerance = abs(tol) <= std::numeric_limits<Scalar>::max();
