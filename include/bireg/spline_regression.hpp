@@ -198,8 +198,20 @@ class SplineRegression {
     bool finite = true;
   };
 
-  // One chunk's share of F and K (parallel.hpp's chunks of the
-  // observations in covariate order): the control points [first, first +
+  // Observations per chunk of the spline's sums: a quarter of
+  // parallel.hpp's kChunkSize, because an observation costs the spline
+  // about 5x what it costs the geodesic and the chunks are claimed whole:
+  // 1e5 observations in chunks of 4096 make 25, which two threads share
+  // 13 to 12 (their sums took 1.93x less time on two, 2026-11-28); in chunks of
+  // 1024 they make 98. Like kChunkSize, it does not depend on the thread
+  // count, so neither do the sums.
+  static constexpr std::size_t kSplineChunkSize = 1024;
+  static std::size_t spline_chunk_count(std::size_t n) {
+    return (n + kSplineChunkSize - 1) / kSplineChunkSize;
+  }
+
+  // One chunk's share of F and K (kSplineChunkSize observations in
+  // covariate order): the control points [first, first +
   // force.size()), and K's rows for them laid out as BlockBandedMatrix's.
   struct ChunkPartial {
     std::size_t begin = 0, end = 0;  // positions in the covariate order
@@ -218,13 +230,15 @@ class SplineRegression {
         : increments(knots.control_points - 1),
           jacobians(knots.control_points - 1),
           order(std::move(sorted)),
-          partials(chunk_count(order.size())),
+          partials(spline_chunk_count(order.size())),
           pool(chunk_pool) {
+      // Each partial is allocated (and its pages first touched) by the
+      // thread that claims its chunk, as in every later pass.
       const auto k = static_cast<std::size_t>(degree);
-      for (std::size_t chunk = 0; chunk < partials.size(); ++chunk) {
+      run_pieces(pool, partials.size(), [&](std::size_t chunk) {
         ChunkPartial& partial = partials[chunk];
-        partial.begin = chunk * kChunkSize;
-        partial.end = std::min(order.size(), partial.begin + kChunkSize);
+        partial.begin = chunk * kSplineChunkSize;
+        partial.end = std::min(order.size(), partial.begin + kSplineChunkSize);
         const auto segment = [&](std::size_t position) {
           return knot_position(problem.t[order[position]], Scalar(0), knots.h, knots.segments)
               .segment;
@@ -234,7 +248,7 @@ class SplineRegression {
         partial.force.assign(rows, Tangent::Zero());
         partial.mass.assign(rows, Scalar(0));
         partial.blocks.assign(rows * (2 * k + 1), AdMatrix::Zero());
-      }
+      });
     }
     std::vector<Tangent> increments;
     std::vector<IncrementJacobians<G>> jacobians;
@@ -389,10 +403,19 @@ class SplineRegression {
       }
     }
     std::vector<Element> points = anchors;
-    for (std::size_t c = 0; c < knots.control_points; ++c) {
-      if (masses[c] > 0) points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
-    }
+    run_pieces(scratch.pool, control_point_pieces(points.size()), [&](std::size_t piece) {
+      for (std::size_t c = piece * kControlPointPiece;
+           c < std::min(points.size(), (piece + 1) * kControlPointPiece); ++c)
+        if (masses[c] > 0) points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
+    });
     return points;
+  }
+
+  // Control points per piece of a pass over them on the pool (an exp and
+  // a product each: 1024 take about 30 us on SO(3)).
+  static constexpr std::size_t kControlPointPiece = 1024;
+  static std::size_t control_point_pieces(std::size_t m) {
+    return (m + kControlPointPiece - 1) / kControlPointPiece;
   }
 
   // body(piece) for every piece in [0, pieces), on the pool's threads
@@ -475,19 +498,38 @@ class SplineRegression {
       }
     };
     run_pieces(scratch.pool, scratch.partials.size(), chunk_sum);
-    if (jacobian) jacobian->set_zero();
+    // F and K from the partial sums, by pieces of kReduceRows control
+    // points on the pool: a piece zeroes its rows of K and adds, row by
+    // row, the partials that hold the row in chunk order (the order of a
+    // serial sum, so the same bits). The partials holding a row are
+    // consecutive: their first and last rows never decrease.
+    constexpr std::size_t kReduceRows = 512;
     const std::size_t m = points.size();
-    for (const ChunkPartial& partial : scratch.partials) {
-      for (std::size_t r = 0; r < partial.force.size(); ++r) {
-        const std::size_t c = partial.first + r;
-        evaluation.force[c] += partial.force[r];
-        if (!jacobian) continue;
-        for (std::size_t o = 0; o < band; ++o) {
-          if (c + o < std::size_t(k) || c + o - std::size_t(k) >= m) continue;
-          (*jacobian)(c, c + o - std::size_t(k)) += partial.blocks[r * band + o];
+    const auto reduce_piece = [&](std::size_t piece) {
+      const std::size_t begin = piece * kReduceRows, end = std::min(m, begin + kReduceRows);
+      if (jacobian) {
+        for (std::size_t c = begin; c < end; ++c)
+          for (std::size_t l = c > std::size_t(k) ? c - std::size_t(k) : 0;
+               l <= std::min(m - 1, c + std::size_t(k)); ++l)
+            (*jacobian)(c, l).setZero();
+      }
+      auto partial = std::partition_point(
+          scratch.partials.begin(), scratch.partials.end(),
+          [begin](const ChunkPartial& p) { return p.first + p.force.size() <= begin; });
+      for (; partial != scratch.partials.end() && partial->first < end; ++partial) {
+        const std::size_t last = std::min(end, partial->first + partial->force.size());
+        for (std::size_t c = std::max(begin, partial->first); c < last; ++c) {
+          const std::size_t r = c - partial->first;
+          evaluation.force[c] += partial->force[r];
+          if (!jacobian) continue;
+          for (std::size_t o = 0; o < band; ++o) {
+            if (c + o < std::size_t(k) || c + o - std::size_t(k) >= m) continue;
+            (*jacobian)(c, c + o - std::size_t(k)) += partial->blocks[r * band + o];
+          }
         }
       }
-    }
+    };
+    run_pieces(scratch.pool, (m + kReduceRows - 1) / kReduceRows, reduce_piece);
     for (const Tangent& f : evaluation.force)
       evaluation.merit += f.squaredNorm();
     evaluation.finite = std::isfinite(evaluation.merit);
@@ -592,7 +634,7 @@ std::optional<Rejection> SplineRegression<G>::prepare(const Observations& observ
     return rejection;
   }
   if (options_.threads > 1 && n >= kParallelMinimum) {
-    out.pool.emplace(options_.threads, chunk_count(n));
+    out.pool.emplace(options_.threads, spline_chunk_count(n));
   }
   if (auto rejection = check_observations<G>(observations, options_.element_tolerance,
                                              out.pool ? &*out.pool : nullptr)) {
@@ -661,7 +703,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
     ++result.iterations;
     for (std::size_t c = 0; c < step.size(); ++c)
       step[c] = -current.force[c];
-    if (!jacobian.solve(step)) {
+    if (!jacobian.solve(step, chunk_pool)) {
       result.status = Status::no_descent;
       result.message = "the Gauss-Newton matrix is singular at the current control points";
       break;
@@ -677,8 +719,11 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
     bool accepted = false;
     Scalar scale = 1;
     for (int halving = 0; halving <= kHalvings && !accepted; ++halving, scale /= 2) {
-      for (std::size_t c = 0; c < points.size(); ++c)
-        trial[c] = G::compose(points[c], G::exp(scale * step[c]));
+      run_pieces(chunk_pool, control_point_pieces(points.size()), [&](std::size_t piece) {
+        for (std::size_t c = piece * kControlPointPiece;
+             c < std::min(points.size(), (piece + 1) * kControlPointPiece); ++c)
+          trial[c] = G::compose(points[c], G::exp(scale * step[c]));
+      });
       // The full step's trial assembles K as it goes (it is usually
       // taken); a halved one only F, and K is assembled once it is taken.
       const bool full_step = halving == 0;
