@@ -4,13 +4,13 @@
 // 1, 3 and 6; the same bits with and without a pool; singular pivots found
 // on either side and in the interface.
 //
-// Tolerance: block LU without pivoting between blocks is backward stable
-// when the growth of its blocks is O(1), as it is for the block diagonally
-// dominant matrices here (and for K near -H kron I): the residual of the
-// computed x satisfies ||K x - b|| <= c n eps (||K|| ||x|| + ||b||) with n
-// = M d unknowns and c a small constant (Higham, Accuracy and Stability of
-// Numerical Algorithms, 2nd ed., Theorem 9.3 with growth O(1)); c = 4 is
-// taken, with infinity norms.
+// Tolerance: LU without pivoting between blocks is backward stable when
+// the growth of its blocks is O(1), as it is for the strongly shifted
+// diagonal blocks here (and for K near -H kron I, H positive definite):
+// the computed x satisfies ||K x - b|| <= c n eps (||K|| ||x|| + ||b||)
+// with n = M d unknowns and c a small constant (Higham, Accuracy and
+// Stability of Numerical Algorithms, 2nd ed., Theorem 9.4 for the solve
+// and chapter 13 for block LU); c = 4, with infinity norms.
 #include <cstddef>
 #include <limits>
 #include <random>
@@ -34,8 +34,8 @@ struct Banded {
 };
 
 // A random block-banded K with M block rows, band k: Gaussian blocks,
-// each diagonal block shifted by -(2k + 1) d (block diagonally dominant,
-// the sign of K near -H kron I); also returned dense.
+// each diagonal block shifted by -(2k + 1) d (well conditioned for these
+// seeds; the sign of K near -H kron I); also returned dense.
 template <int D>
 typename Banded<D>::Matrix random_banded(std::mt19937& rng, std::size_t m, std::size_t k,
                                          Eigen::MatrixXd& dense) {

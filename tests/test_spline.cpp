@@ -232,6 +232,59 @@ TEST_CASE("Spline fit in R^3 is least-squares B-spline regression", "[spline]") 
   }
 }
 
+// The same at the sizes where the fit works in pieces: 12,000 observations
+// (12 chunks of 1024), 1,203 control points (three pieces of 512 rows when
+// the chunks' sums are added, two pieces of control-point updates, and the
+// banded solve split in two), and 6 control points (3 segments of 4,000
+// observations: several chunks begin at the same control point); on one
+// thread and on two. Tolerance as above: the equations are
+// linear, so Gauss-Newton lands on the solution in one step and the next
+// measures its rounding.
+TEST_CASE("Spline fit in R^3 by pieces: every chunk's sums added once", "[spline][threads]") {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  constexpr int kCount = 12000;
+  for (const double range : {1200.0, 3.0}) {
+    std::vector<R3::Element> f;
+    std::vector<double> t, w;
+    for (int i = 0; i < kCount; ++i) {
+      t.push_back(range * (i + 0.5 * uniform(rng)) / kCount);
+      w.push_back(0.5 + uniform(rng));
+      const double x = 10 * t.back() / range;
+      f.push_back(R3::Element(std::sin(x), std::cos(0.7 * x), 0.1 * x) +
+                  bireg_test::normal_tangent<R3::Tangent>(rng, 0.1));
+    }
+    for (const int threads : {1, 2}) {
+      CAPTURE(range, threads);
+      bireg::SplineOptions<double> options;
+      options.degree = 3;
+      options.knot_spacing = 1;  // 1200 segments, or 3
+      options.threads = threads;
+      const auto fit = bireg::SplineRegression<R3>(options).fit(f, t, w);
+      REQUIRE(fit.ok());
+      const auto& curve = *fit.spline;
+      const std::size_t m = curve.control_points().size();
+      CHECK(m == (range == 3.0 ? 6u : 1203u));
+      Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(m, m), rhs = Eigen::MatrixXd::Zero(m, 3);
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        const auto at = curve.position(t[i]);
+        const auto basis = bireg::spline_basis(3, at.u);
+        for (int a = 0; a <= 3; ++a) {
+          rhs.row(at.segment + a) += w[i] * basis.ordinary[a] * f[i].transpose();
+          for (int b = 0; b <= 3; ++b)
+            normal(at.segment + a, at.segment + b) += w[i] * basis.ordinary[a] * basis.ordinary[b];
+        }
+      }
+      const Eigen::MatrixXd solution = normal.ldlt().solve(rhs);
+      double largest = 0;
+      for (std::size_t c = 0; c < m; ++c)
+        largest =
+            std::max(largest, (curve.control_points()[c] - solution.row(c).transpose()).norm());
+      CHECK(largest < 4 * kCount * std::numeric_limits<double>::epsilon());
+    }
+  }
+}
+
 // Theorem 2.4's argument with (4) (splines.md §6): translating the data
 // on the left or the right translates every control point.
 TEST_CASE("Spline fit is left and right equivariant", "[spline]") {

@@ -202,9 +202,9 @@ class SplineRegression {
   // parallel.hpp's kChunkSize, because an observation costs the spline
   // about 5x what it costs the geodesic and the chunks are claimed whole:
   // 1e5 observations in chunks of 4096 make 25, which two threads share
-  // 13 to 12 (their sums took 1.93x less time on two, 2026-11-28); in chunks of
-  // 1024 they make 98. Like kChunkSize, it does not depend on the thread
-  // count, so neither do the sums.
+  // 13 to 12 (at best 1.92x less time on two); in chunks of 1024 they
+  // make 98. Like kChunkSize, it does not depend on the thread count, so
+  // neither do the sums.
   static constexpr std::size_t kSplineChunkSize = 1024;
   static std::size_t spline_chunk_count(std::size_t n) {
     return (n + kSplineChunkSize - 1) / kSplineChunkSize;
@@ -215,7 +215,7 @@ class SplineRegression {
   // force.size()), and K's rows for them laid out as BlockBandedMatrix's.
   struct ChunkPartial {
     std::size_t begin = 0, end = 0;  // positions in the covariate order
-    std::size_t first = 0;
+    std::size_t first = 0, rows = 0;
     std::vector<Tangent> force;
     std::vector<Scalar> mass;  // the start's sums of weights
     std::vector<AdMatrix> blocks;
@@ -232,22 +232,30 @@ class SplineRegression {
           order(std::move(sorted)),
           partials(spline_chunk_count(order.size())),
           pool(chunk_pool) {
-      // Each partial is allocated (and its pages first touched) by the
-      // thread that claims its chunk, as in every later pass.
+      // Each partial is allocated here, where std::bad_alloc can leave
+      // fit() (a worker must not throw), and its pages are first touched,
+      // zeroed, by the thread that claims its chunk, as in every later
+      // pass: assign() within the reserved capacity does not allocate.
       const auto k = static_cast<std::size_t>(degree);
-      run_pieces(pool, partials.size(), [&](std::size_t chunk) {
+      const auto segment = [&](std::size_t position) {
+        return knot_position(problem.t[order[position]], Scalar(0), knots.h, knots.segments)
+            .segment;
+      };
+      for (std::size_t chunk = 0; chunk < partials.size(); ++chunk) {
         ChunkPartial& partial = partials[chunk];
         partial.begin = chunk * kSplineChunkSize;
         partial.end = std::min(order.size(), partial.begin + kSplineChunkSize);
-        const auto segment = [&](std::size_t position) {
-          return knot_position(problem.t[order[position]], Scalar(0), knots.h, knots.segments)
-              .segment;
-        };
         partial.first = segment(partial.begin);
-        const std::size_t rows = segment(partial.end - 1) + k + 1 - partial.first;
-        partial.force.assign(rows, Tangent::Zero());
-        partial.mass.assign(rows, Scalar(0));
-        partial.blocks.assign(rows * (2 * k + 1), AdMatrix::Zero());
+        partial.rows = segment(partial.end - 1) + k + 1 - partial.first;
+        partial.force.reserve(partial.rows);
+        partial.mass.reserve(partial.rows);
+        partial.blocks.reserve(partial.rows * (2 * k + 1));
+      }
+      run_pieces(pool, partials.size(), [&](std::size_t chunk) {
+        ChunkPartial& partial = partials[chunk];
+        partial.force.assign(partial.rows, Tangent::Zero());
+        partial.mass.assign(partial.rows, Scalar(0));
+        partial.blocks.assign(partial.rows * (2 * k + 1), AdMatrix::Zero());
       });
     }
     std::vector<Tangent> increments;

@@ -75,7 +75,8 @@ class BlockBandedMatrix {
     });
     if (!side_invertible[0] || !side_invertible[1]) return false;
     // B's Schur updates of I x I, left out of eliminate_bottom() because
-    // T writes the same blocks: from B's first k pivots, in its order.
+    // T writes the same blocks: from the last k pivots of B's upward
+    // sweep (rows s + k .. s + 2k - 1), in that sweep's order.
     for (std::size_t c = bottom_interface_end(); c-- > interface_end_;) {
       for (std::size_t r = c - band_; r < interface_end_; ++r)
         for (std::size_t q = c - band_; q < interface_end_; ++q)

@@ -226,7 +226,7 @@ struct Pooled {
 // ad(sum z_i) / 2: of the order of |m - p|, the subset mean's distance from
 // the pooled one, which is small wherever relabelling makes sense. It
 // stops by mean.hpp's rule (a step of at most options.tolerance, 1e-10 by
-// default) but, linear and without taking that last step, is only about
+// default in double) but, linear and without taking that last step, is only about
 // that step's size from the root (1e-11 to 1e-10 on samples like
 // test_cohorts.cpp's), where Newton's last step leaves rounding error
 // (1e-16). False when it does not stop in kMaxChordSteps or a step fails
