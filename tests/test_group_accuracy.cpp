@@ -137,6 +137,15 @@ TEMPLATE_TEST_CASE("coefficient functions are accurate over the whole range", "[
     const long double half_cot_ref =
         xl == 0 ? 1.0L : (xl / 2) * std::cos(xl / 2) / std::sin(xl / 2);
     REQUIRE(relative<Scalar>(sa::half_x_cot_half_x(x), half_cot_ref) <= tolerance);
+    // The forms taking x^2 (SO(3)'s Jacobians), against the references at
+    // the square root of the rounded square they see.
+    const Scalar x2 = x * x;
+    const long double root = std::sqrt(static_cast<long double>(x2));
+    const long double half_root_sinc = root == 0 ? 1.0L : std::sin(root / 2) / (root / 2);
+    REQUIRE(relative<Scalar>(sa::one_minus_cos_over_x2_from_square(x2),
+                             half_root_sinc * half_root_sinc / 2) <= tolerance);
+    REQUIRE(relative<Scalar>(sa::x_minus_sin_over_x3_from_square(x2),
+                             reference_x_minus_sin_over_x3(root)) <= tolerance);
   }
 }
 

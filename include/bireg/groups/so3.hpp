@@ -209,30 +209,40 @@ struct SO3 {
   //   J_r(omega)      = I - ((1 - cos t)/t^2) W + ((t - sin t)/t^3) W^2,
   //   J_r(omega)^{-1} = I + W/2 + ((1 - (t/2) cot(t/2))/t^2) W^2,
   // W = hat(omega), t = |omega|; the inverse exists for t < 2 pi.
+  // The coefficients are series in t^2 below t = 2 (small_angle.hpp), so
+  // the usual short arguments take neither a square root nor a sine; W^2 is
+  // formed entry by entry as in rodrigues().
   static AdMatrix right_jacobian(const Tangent& omega) {
-    using std::sqrt;
-    const Scalar angle = sqrt(omega.squaredNorm());
-    const Algebra w = hat(omega);
-    return AdMatrix::Identity() - small_angle::one_minus_cos_over_x2(angle) * w +
-           small_angle::x_minus_sin_over_x3(angle) * (w * w);
+    const Scalar squared_angle = omega.squaredNorm();
+    return AdMatrix::Identity() -
+           small_angle::one_minus_cos_over_x2_from_square(squared_angle) * hat(omega) +
+           small_angle::x_minus_sin_over_x3_from_square(squared_angle) * hat_squared(omega);
   }
   static AdMatrix right_jacobian_inverse(const Tangent& omega) {
-    using std::sqrt;
-    const Scalar angle = sqrt(omega.squaredNorm());
-    const Algebra w = hat(omega);
-    return AdMatrix::Identity() + w / Scalar(2) +
-           small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * (w * w);
+    return AdMatrix::Identity() + hat(omega) / Scalar(2) +
+           small_angle::one_minus_half_x_cot_half_x_over_x2_from_square(omega.squaredNorm()) *
+               hat_squared(omega);
   }
   // Both at once: W, W^2 and the angle are shared.
   static RightJacobianPair<AdMatrix> right_jacobian_pair(const Tangent& omega) {
-    using std::sqrt;
-    const Scalar angle = sqrt(omega.squaredNorm());
+    const Scalar squared_angle = omega.squaredNorm();
     const Algebra w = hat(omega);
-    const Algebra w2 = w * w;
-    return {AdMatrix::Identity() - small_angle::one_minus_cos_over_x2(angle) * w +
-                small_angle::x_minus_sin_over_x3(angle) * w2,
+    const Algebra w2 = hat_squared(omega);
+    return {AdMatrix::Identity() -
+                small_angle::one_minus_cos_over_x2_from_square(squared_angle) * w +
+                small_angle::x_minus_sin_over_x3_from_square(squared_angle) * w2,
             AdMatrix::Identity() + w / Scalar(2) +
-                small_angle::one_minus_half_x_cot_half_x_over_x2(angle) * w2};
+                small_angle::one_minus_half_x_cot_half_x_over_x2_from_square(squared_angle) * w2};
+  }
+  // hat(omega)^2 = omega omega^T - |omega|^2 I, whose diagonal is -(the
+  // other two squares): no 3 x 3 product and no cancellation.
+  static Algebra hat_squared(const Tangent& omega) {
+    const Tangent square = omega.cwiseAbs2();
+    const Scalar w01 = omega[0] * omega[1], w02 = omega[0] * omega[2], w12 = omega[1] * omega[2];
+    Algebra w2;
+    w2 << -(square[1] + square[2]), w01, w02, w01, -(square[0] + square[2]), w12, w02, w12,
+        -(square[0] + square[1]);
+    return w2;
   }
 
   // The algebra of functions of ad_omega = W (math/ad_algebra.hpp), with

@@ -71,6 +71,18 @@ constexpr std::array<long double, Count> x_minus_sin_series() {
   return c;
 }
 
+// Taylor coefficients of (1 - cos x)/x^2 in powers of x^2: (-1)^k / (2k+2)!.
+template <std::size_t Count>
+constexpr std::array<long double, Count> one_minus_cos_series() {
+  std::array<long double, Count> c{};
+  long double factorial = 2.0L;  // 2!
+  for (std::size_t k = 0; k < Count; ++k) {
+    c[k] = (k % 2 == 0 ? 1.0L : -1.0L) / factorial;
+    factorial *= static_cast<long double>((2 * k + 3) * (2 * k + 4));
+  }
+  return c;
+}
+
 // Taylor coefficients of (1 - (x/2) cot(x/2))/x^2 in powers of x^2. From
 // y cot y = sum_n (-4)^n B_2n y^2n / (2n)!, with y = x/2:
 // (x/2) cot(x/2) = 1 - sum_{n>=1} |B_2n| x^2n / (2n)!, so the coefficient of
@@ -125,6 +137,18 @@ Scalar one_minus_cos_over_x2(Scalar x) {
   return s * s / Scalar(2);
 }
 
+// The same from x^2 (x >= 0 its square root), for callers holding
+// |omega|^2: below x = 2 the series in x^2, which converges with ratio
+// x^2/((2k+3)(2k+4)) (14 terms leave 4^14/30! < 1e-23 at x = 2), needs
+// neither the square root nor a sine.
+template <class Scalar>
+Scalar one_minus_cos_over_x2_from_square(Scalar x2) {
+  using std::sqrt;
+  static constexpr auto kSeries = in_precision<Scalar>(detail::one_minus_cos_series<14>());
+  if (x2 < Scalar(4)) return polynomial(kSeries, x2);
+  return one_minus_cos_over_x2(sqrt(x2));
+}
+
 // (x - sin x)/x^3. The direct formula's relative rounding error is about
 // eps * x / (x - sin x): 6/x^2 eps for small x, below 2 eps for |x| >= 2
 // (x - sin x = 1.09 at x = 2). Below 2 the series in x^2 converges with ratio
@@ -136,6 +160,14 @@ Scalar x_minus_sin_over_x3(Scalar x) {
   static constexpr auto kSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
   if (abs(x) < Scalar(2)) return polynomial(kSeries, x * x);
   return (x - sin(x)) / (x * x * x);
+}
+// The same from x^2 (x >= 0 its square root).
+template <class Scalar>
+Scalar x_minus_sin_over_x3_from_square(Scalar x2) {
+  using std::sqrt;
+  static constexpr auto kSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
+  if (x2 < Scalar(4)) return polynomial(kSeries, x2);
+  return x_minus_sin_over_x3(sqrt(x2));
 }
 
 // (x/2) cot(x/2), the diagonal of the inverse of SE(2)'s V matrix. As a
