@@ -183,3 +183,31 @@ TEST_CASE("SmallLU solves, inverts and takes determinants to n^2 eps", "[math][s
     CHECK_FALSE(bireg::SmallLU<Eigen::Matrix<double, 12, 12>>(a).invertible());
   }
 }
+
+// adjugate_inverse: A X - I = (A E - (delta det) I) / det, where E is the
+// adjugate's rounding (each cofactor a difference of two products: at most
+// 2 eps ||A||^2 per entry, so ||A E|| <= 6 eps ||A||^3) and delta det the
+// determinant's (three products and two sums of cofactors: <= 4 eps
+// ||A||^3); with max-norms, ||A X - I|| <= 10 eps ||A||^3 / |det|, plus
+// the test's own product A X (3 eps ||A|| ||X||).
+TEST_CASE("adjugate_inverse inverts 3 x 3 matrices to the adjugate's bound", "[math][small_lu]") {
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 200; ++trial) {
+    CAPTURE(trial);
+    const Eigen::VectorXd lambda = spectrum(rng, 3, trial % 3);  // kind 2: cond 1e12
+    if (lambda.cwiseAbs().minCoeff() == 0) continue;             // kind 1 is singular
+    const Dynamic q = random_orthogonal(rng, 3);
+    const Eigen::Matrix3d a = q * lambda.asDiagonal() * q.transpose();
+    const Eigen::Matrix3d x = bireg::adjugate_inverse(a);
+    const double norm = a.cwiseAbs().maxCoeff();
+    const double bound = 10 * kEps * norm * norm * norm / std::abs(lambda.prod()) +
+                         3 * kEps * norm * x.cwiseAbs().maxCoeff();
+    CHECK((a * x - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= bound);
+    const Eigen::Matrix3d expected = q * lambda.cwiseInverse().asDiagonal() * q.transpose();
+    // X - A^{-1} = A^{-1} (A X - I): at most 3 ||A^{-1}|| ||A X - I|| in max-norms.
+    CHECK((x - expected).cwiseAbs().maxCoeff() <= 3 * expected.cwiseAbs().maxCoeff() * bound);
+  }
+  Eigen::Matrix3d singular;  // rows 0 and 1 parallel: the determinant is exactly 0
+  singular << 1, 2, 3, 2, 4, 6, 0, 0, 1;
+  CHECK_FALSE(bireg::adjugate_inverse(singular).allFinite());
+}

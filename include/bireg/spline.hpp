@@ -108,7 +108,9 @@ void evaluate_segment(int degree, const typename G::Tangent* increments,
   for (int j = degree; j >= 1; --j) {
     product.omega[j] = increments[j - 1];
     product.factor[j] = G::exp(basis.cumulative[j] * product.omega[j]);
-    product.suffix[j - 1] = G::compose(product.factor[j], product.suffix[j]);
+    // S_{k-1} = A_k I = A_k exactly: the product with the identity is skipped.
+    product.suffix[j - 1] =
+        j == degree ? product.factor[j] : G::compose(product.factor[j], product.suffix[j]);
   }
 }
 

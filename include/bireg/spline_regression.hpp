@@ -90,6 +90,9 @@ struct SplineResult {
   std::optional<Spline<G>> spline;
   int iterations = 0;              // Gauss-Newton steps proposed (the last certifies)
   std::vector<Scalar> step_norms;  // the largest control-point component of each
+  // Times K (the Gauss-Newton matrix) was assembled: at most one per step,
+  // fewer where the steps from an earlier K contract well (splines.md §9).
+  int jacobian_evaluations = 0;
   std::vector<Tangent> residuals;  // r_i = log(T(t_i)^{-1} f_i), input order
   // max_c |F_c| at the returned control points (splines.md (6)), weights
   // normalised to a largest of 1.
@@ -206,9 +209,6 @@ class SplineRegression {
   // make 98. Like kChunkSize, it does not depend on the thread count, so
   // neither do the sums.
   static constexpr std::size_t kSplineChunkSize = 1024;
-  static std::size_t spline_chunk_count(std::size_t n) {
-    return (n + kSplineChunkSize - 1) / kSplineChunkSize;
-  }
 
   // One chunk's share of F and K (kSplineChunkSize observations in
   // covariate order): the control points [first, first +
@@ -230,7 +230,7 @@ class SplineRegression {
         : increments(knots.control_points - 1),
           jacobians(knots.control_points - 1),
           order(std::move(sorted)),
-          partials(spline_chunk_count(order.size())),
+          partials(chunk_count(order.size(), kSplineChunkSize)),
           pool(chunk_pool) {
       // Each partial is allocated here, where std::bad_alloc can leave
       // fit() (a worker must not throw), and its pages are first touched,
@@ -411,20 +411,21 @@ class SplineRegression {
       }
     }
     std::vector<Element> points = anchors;
-    run_pieces(scratch.pool, control_point_pieces(points.size()), [&](std::size_t piece) {
-      for (std::size_t c = piece * kControlPointPiece;
-           c < std::min(points.size(), (piece + 1) * kControlPointPiece); ++c)
-        if (masses[c] > 0) points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
-    });
+    run_ranges(scratch.pool, points.size(), kControlPointPiece,
+               [&](std::size_t begin, std::size_t end) {
+                 for (std::size_t c = begin; c < end; ++c)
+                   if (masses[c] > 0)
+                     points[c] = G::compose(anchors[c], G::exp(sums[c] / masses[c]));
+               });
     return points;
   }
 
   // Control points per piece of a pass over them on the pool (an exp and
   // a product each: 1024 take about 30 us on SO(3)).
   static constexpr std::size_t kControlPointPiece = 1024;
-  static std::size_t control_point_pieces(std::size_t m) {
-    return (m + kControlPointPiece - 1) / kControlPointPiece;
-  }
+  // The contraction a step from K assembled at earlier control points
+  // must show against the step before it to be taken (docs/splines.md §9).
+  static constexpr Scalar kReuseContraction = Scalar(0.01);
 
   // body(piece) for every piece in [0, pieces), on the pool's threads
   // when there is one.
@@ -436,6 +437,14 @@ class SplineRegression {
       for (std::size_t piece = 0; piece < pieces; ++piece)
         body(piece);
     }
+  }
+
+  // body(begin, end) over [0, n) in ranges of `size` (the last one
+  // short), on the pool's threads when there is one.
+  template <class Body>
+  static void run_ranges(ChunkPool* pool, std::size_t n, std::size_t size, const Body& body) {
+    run_pieces(pool, chunk_count(n, size),
+               [&](std::size_t piece) { body(piece * size, std::min(n, (piece + 1) * size)); });
   }
 
   // The residuals, F and sum |F|^2 at `points` into `evaluation`; K too
@@ -458,15 +467,13 @@ class SplineRegression {
     // The increments and their Jacobians, by pieces of kIncrementChunk on
     // the pool (each piece writes its own entries).
     constexpr std::size_t kIncrementChunk = 1024;
-    const auto increment_piece = [&](std::size_t piece) {
-      const std::size_t end = std::min(increments.size(), (piece + 1) * kIncrementChunk);
-      for (std::size_t j = piece * kIncrementChunk; j < end; ++j) {
-        increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
-        increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
-      }
-    };
-    const std::size_t pieces = (increments.size() + kIncrementChunk - 1) / kIncrementChunk;
-    run_pieces(scratch.pool, pieces, increment_piece);
+    run_ranges(scratch.pool, increments.size(), kIncrementChunk,
+               [&](std::size_t begin, std::size_t end) {
+                 for (std::size_t j = begin; j < end; ++j) {
+                   increments[j] = G::log(G::compose(G::inverse(points[j]), points[j + 1]));
+                   increment_jacobians[j] = IncrementJacobians<G>::of(increments[j]);
+                 }
+               });
     for (const Tangent& increment : increments) {
       if (!increment.allFinite()) {
         evaluation.finite = false;
@@ -479,6 +486,7 @@ class SplineRegression {
       if (jacobian) std::fill(partial.blocks.begin(), partial.blocks.end(), AdMatrix::Zero());
       SegmentProduct<G> product;
       ControlPointDifferentials<G> differentials;
+      std::array<Tangent, kMaxSplineDegree + 1> terms;
       for (std::size_t position = partial.begin; position < partial.end; ++position) {
         const std::size_t i = scratch.order[position];
         const KnotPosition<Scalar> at =
@@ -489,11 +497,11 @@ class SplineRegression {
         residuals[i] = G::log(G::compose(G::inverse(curve), observations[i]));
         const Scalar w = problem.w[i];
         if (!(w > 0)) continue;
-        control_point_differentials<G>(k, basis, product, &increment_jacobians[at.segment],
-                                       differentials);
+        weighted_residuals<G>(k, basis, product, &increment_jacobians[at.segment], residuals[i],
+                              terms, jacobian ? &differentials : nullptr);
         const std::size_t row = at.segment - partial.first;  // of j = 0
         for (int j = 0; j <= k; ++j)
-          partial.force[row + std::size_t(j)] += w * (differentials.weight[j] * residuals[i]);
+          partial.force[row + std::size_t(j)] += w * terms[std::size_t(j)];
         if (!jacobian) continue;
         // K_cl = -sum_i w_i W_c J_l(r_i)^{-1} D_l (splines.md §9).
         const AdMatrix left_inverse = right_jacobian_inverse<G>((-residuals[i]).eval());
@@ -513,8 +521,7 @@ class SplineRegression {
     // consecutive: their first and last rows never decrease.
     constexpr std::size_t kReduceRows = 512;
     const std::size_t m = points.size();
-    const auto reduce_piece = [&](std::size_t piece) {
-      const std::size_t begin = piece * kReduceRows, end = std::min(m, begin + kReduceRows);
+    const auto reduce_rows = [&](std::size_t begin, std::size_t end) {
       if (jacobian) {
         for (std::size_t c = begin; c < end; ++c)
           for (std::size_t l = c > std::size_t(k) ? c - std::size_t(k) : 0;
@@ -537,7 +544,7 @@ class SplineRegression {
         }
       }
     };
-    run_pieces(scratch.pool, (m + kReduceRows - 1) / kReduceRows, reduce_piece);
+    run_ranges(scratch.pool, m, kReduceRows, reduce_rows);
     for (const Tangent& f : evaluation.force)
       evaluation.merit += f.squaredNorm();
     evaluation.finite = std::isfinite(evaluation.merit);
@@ -642,7 +649,7 @@ std::optional<Rejection> SplineRegression<G>::prepare(const Observations& observ
     return rejection;
   }
   if (options_.threads > 1 && n >= kParallelMinimum) {
-    out.pool.emplace(options_.threads, spline_chunk_count(n));
+    out.pool.emplace(options_.threads, chunk_count(n, kSplineChunkSize));
   }
   if (auto rejection = check_observations<G>(observations, options_.element_tolerance,
                                              out.pool ? &*out.pool : nullptr)) {
@@ -697,6 +704,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   BlockBandedMatrix<AdMatrix, Tangent> trial_jacobian = jacobian;
   Evaluation current(knots.control_points), next(knots.control_points);
   evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
+  result.jacobian_evaluations = 1;
   if (!current.finite) {
     return rejected(
         {"the estimating equations are not finite at the start: consecutive control "
@@ -707,18 +715,46 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   std::vector<Element> trial(knots.control_points);
   result.status = Status::max_iterations;
   constexpr int kHalvings = 30;
-  for (int iteration = 0; iteration < options_.max_iterations; ++iteration) {
-    ++result.iterations;
-    for (std::size_t c = 0; c < step.size(); ++c)
-      step[c] = -current.force[c];
-    if (!jacobian.solve(step, chunk_pool)) {
+  // K is reused while it still contracts (docs/splines.md §9, "Reusing
+  // K"): `assembled_here` says whether the factors are K's at `points`;
+  // a step from older factors is taken only if it contracts by
+  // kReuseContraction against the step before it, and otherwise K is
+  // assembled at `points` and the step recomputed (once per fit: after a
+  // poor reuse K is assembled with every step). The decisions depend on
+  // the steps' norms alone, so the bits still do not depend on the
+  // thread count.
+  bool factored = false, assembled_here = true, reuse = true;
+  Scalar previous_norm = 0;  // the last step taken (0: none yet)
+  const auto assemble_here = [&] {
+    evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
+    ++result.jacobian_evaluations;
+    factored = false;
+    assembled_here = true;
+  };
+  while (result.iterations < options_.max_iterations) {
+    if (!factored && !(factored = jacobian.factorize(chunk_pool))) {
       result.status = Status::no_descent;
       result.message = "the Gauss-Newton matrix is singular at the current control points";
       break;
     }
+    for (std::size_t c = 0; c < step.size(); ++c)
+      step[c] = -current.force[c];
+    const bool solved = jacobian.substitute(step, chunk_pool);
     Scalar norm = 0;
     for (const Tangent& s : step)
       norm = std::max(norm, s.template lpNorm<Eigen::Infinity>());
+    const bool contracts = solved && norm <= kReuseContraction * previous_norm;
+    if (!assembled_here && !contracts) {
+      reuse = false;
+      assemble_here();
+      continue;
+    }
+    if (!solved) {
+      result.status = Status::no_descent;
+      result.message = "the Gauss-Newton step is not finite at the current control points";
+      break;
+    }
+    ++result.iterations;
     result.step_norms.push_back(norm);
     if (norm <= options_.tolerance) {
       result.status = Status::converged;
@@ -727,28 +763,42 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
     bool accepted = false;
     Scalar scale = 1;
     for (int halving = 0; halving <= kHalvings && !accepted; ++halving, scale /= 2) {
-      run_pieces(chunk_pool, control_point_pieces(points.size()), [&](std::size_t piece) {
-        for (std::size_t c = piece * kControlPointPiece;
-             c < std::min(points.size(), (piece + 1) * kControlPointPiece); ++c)
-          trial[c] = G::compose(points[c], G::exp(scale * step[c]));
-      });
-      // The full step's trial assembles K as it goes (it is usually
-      // taken); a halved one only F, and K is assembled once it is taken.
+      run_ranges(chunk_pool, points.size(), kControlPointPiece,
+                 [&](std::size_t begin, std::size_t end) {
+                   for (std::size_t c = begin; c < end; ++c)
+                     trial[c] = G::compose(points[c], G::exp(scale * step[c]));
+                 });
+      // The full step's trial assembles K as it goes unless this K is to
+      // be reused there; a halved one only F, and K is assembled once it
+      // is taken.
       const bool full_step = halving == 0;
+      const bool with_jacobian = full_step && !(reuse && contracts);
       evaluate(observations, problem, knots, trial, trial_residuals,
-               full_step ? &trial_jacobian : nullptr, scratch, next);
+               with_jacobian ? &trial_jacobian : nullptr, scratch, next);
+      result.jacobian_evaluations += with_jacobian;
       if (next.finite && next.merit < current.merit) {
         accepted = true;
         points.swap(trial);
         result.residuals.swap(trial_residuals);
         std::swap(current, next);
-        if (full_step) {
+        if (with_jacobian) {
           std::swap(jacobian, trial_jacobian);
+          factored = false;
+          assembled_here = true;
+        } else if (full_step) {
+          assembled_here = false;
         } else {
-          evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch,
-                   current);
+          assemble_here();
         }
+      } else if (!assembled_here) {
+        break;  // not halved: older factors are not trusted that far
       }
+    }
+    if (!accepted && !assembled_here) {
+      // Older factors may point nowhere useful: retry from K at `points`.
+      reuse = false;
+      assemble_here();
+      continue;
     }
     if (!accepted) {
       // No step reduces |F|: at the rounding floor when the step is at the
@@ -758,6 +808,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       if (!floor) result.message = no_descent_message(result.residuals, points, step);
       break;
     }
+    previous_norm = norm;
   }
   for (const Tangent& f : current.force)
     result.equation_norm = std::max(result.equation_norm, f.norm());

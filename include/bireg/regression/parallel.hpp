@@ -41,8 +41,9 @@ inline constexpr std::size_t kChunkSize = 4096;
 // waking the workers costs more than the chunks they would share.
 inline constexpr std::size_t kParallelMinimum = 2 * kChunkSize;
 
-inline std::size_t chunk_count(std::size_t n) {
-  return (n + kChunkSize - 1) / kChunkSize;
+// Chunks (or pieces) of `size` that cover n items, the last one short.
+inline std::size_t chunk_count(std::size_t n, std::size_t size = kChunkSize) {
+  return (n + size - 1) / size;
 }
 
 // At most this many workers per pool (kMaxThreads threads with the calling

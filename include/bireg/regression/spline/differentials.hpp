@@ -20,7 +20,7 @@
 //   W_k = b_k J_r(Omega_k) J_r(b_k Omega_k)^{-1};
 //
 // the interior ones (0 < j < k, where B_j >= 1/6 for k = 3 and >= 1/2 for
-// k = 2) are inverted as they stand.
+// k = 2) are inverted as they stand (for F alone, D_j x = r is solved).
 #pragma once
 
 #include <array>
@@ -58,42 +58,86 @@ struct ControlPointDifferentials {
   std::array<AdMatrix, kMaxSplineDegree + 1> weight;      // W_j = B_j^2 D_j^{-1}
 };
 
-// `jacobians` points at the Jacobians of the segment's first increment
-// (Omega_{i+1}); `product` is the segment's product at the observation.
+// The terms W_j r_i, j = 0..k, of the estimating equations for one
+// observation with residual r, and D_j and W_j into `matrices` when given
+// (for K and the covariance). The terms are formed from products of
+// vectors where a closed form allows (W_0 r and W_k r), and by solving
+// D_j x = r for the interior ones, so that F costs no 3 x 3 inverse; they
+// are the same arithmetic whether or not the matrices are asked for, so F
+// does not depend on whether K is assembled with it. `jacobians` points at
+// the Jacobians of the segment's first increment (Omega_{i+1}); `product`
+// is the segment's product at the observation.
+template <class G>
+void weighted_residuals(int degree, const SplineBasis<typename G::Scalar>& basis,
+                        const SegmentProduct<G>& product, const IncrementJacobians<G>* jacobians,
+                        const typename G::Tangent& residual,
+                        std::array<typename G::Tangent, kMaxSplineDegree + 1>& terms,
+                        ControlPointDifferentials<G>* matrices = nullptr) {
+  using AdMatrix = typename G::AdMatrix;
+  using Tangent = typename G::Tangent;
+  const int k = degree;
+  const auto& b = basis.ordinary;
+  // E_j = Ad_{S_j^{-1}} b_j J_r(b_j Omega_j), and J_r(b_k Omega_k)^{-1} for
+  // W_k. Degree 1 has no interior point, and its E_1 enters only D_0 and
+  // D_1 (the matrices).
+  std::array<AdMatrix, kMaxSplineDegree + 1> e;
+  for (AdMatrix& block : e)
+    block.setZero();  // e[0] is unused; GCC cannot tell that the rest are set
+  AdMatrix last_inverse = AdMatrix::Identity();  // set at j = k; GCC cannot tell
+  const bool need_e = k > 1 || matrices;
+  for (int j = 1; j <= k; ++j) {
+    const Tangent scaled = basis.cumulative[j] * product.omega[j];
+    AdMatrix right;
+    if (j == k) {
+      const RightJacobianPair<AdMatrix> pair = right_jacobian_pair<G>(scaled);
+      right = pair.jacobian;
+      last_inverse = pair.inverse;
+    } else {
+      right = right_jacobian<G>(scaled);
+    }
+    if (need_e) e[j] = basis.cumulative[j] * (G::Ad(G::inverse(product.suffix[j])) * right);
+  }
+  const IncrementJacobians<G>& first = jacobians[0];
+  const IncrementJacobians<G>& last = jacobians[k - 1];
+  // W_0 r = s J_l(Omega_1) J_l(s Omega_1)^{-1} Ad_{S_1} r, s = b_0, with
+  // J_l(s Omega_1)^{-1} = J_r(-s Omega_1)^{-1}.
+  const AdMatrix anchor_inverse = right_jacobian_inverse<G>((-b[0] * product.omega[1]).eval());
+  const AdMatrix carry = G::Ad(product.suffix[1]);
+  terms[0] = b[0] * (first.left * (anchor_inverse * (carry * residual)));
+  // Interior: D_j = E_j J_r(Omega_j)^{-1} - E_{j+1} J_l(Omega_{j+1})^{-1},
+  // W_j r = B_j^2 D_j^{-1} r.
+  for (int j = 1; j < k; ++j) {
+    const AdMatrix derivative =
+        e[j] * jacobians[j - 1].right_inverse - e[j + 1] * jacobians[j].left_inverse;
+    const auto square = b[j] * b[j];
+    if constexpr (AdMatrix::RowsAtCompileTime == 3) {
+      const AdMatrix inverse = adjugate_inverse(derivative);
+      terms[j] = square * (inverse * residual);
+      if (matrices) matrices->weight[j] = square * inverse;
+    } else {
+      const SmallLU<AdMatrix> lu(derivative);
+      terms[j] = square * lu.solve(residual);
+      if (matrices) matrices->weight[j] = square * lu.inverse();
+    }
+    if (matrices) matrices->derivative[j] = derivative;
+  }
+  // W_k r = b_k J_r(Omega_k) J_r(b_k Omega_k)^{-1} r.
+  terms[k] = b[k] * (last.right * (last_inverse * residual));
+  if (!matrices) return;
+  matrices->derivative[0] = G::Ad(G::inverse(product.suffix[0])) - e[1] * first.left_inverse;
+  matrices->derivative[k] = e[k] * last.right_inverse;
+  matrices->weight[0] = b[0] * (first.left * anchor_inverse) * carry;
+  matrices->weight[k] = b[k] * (last.right * last_inverse);
+}
+
+// D_j and W_j, j = 0..k, for one observation (weighted_residuals' matrices).
 template <class G>
 void control_point_differentials(int degree, const SplineBasis<typename G::Scalar>& basis,
                                  const SegmentProduct<G>& product,
                                  const IncrementJacobians<G>* jacobians,
                                  ControlPointDifferentials<G>& out) {
-  using AdMatrix = typename G::AdMatrix;
-  using Tangent = typename G::Tangent;
-  const int k = degree;
-  // E_j, and J_r(b_k Omega_k)^{-1} for W_k.
-  std::array<AdMatrix, kMaxSplineDegree + 1> e;
-  for (AdMatrix& block : e)
-    block.setZero();  // e[0] is unused; GCC cannot tell that the rest are set
-  AdMatrix last_inverse = AdMatrix::Identity();
-  for (int j = 1; j <= k; ++j) {
-    const Tangent scaled = basis.cumulative[j] * product.omega[j];
-    const RightJacobianPair<AdMatrix> pair = right_jacobian_pair<G>(scaled);
-    e[j] = basis.cumulative[j] * (G::Ad(G::inverse(product.suffix[j])) * pair.jacobian);
-    if (j == k) last_inverse = pair.inverse;
-  }
-  const IncrementJacobians<G>& first = jacobians[0];
-  out.derivative[0] = G::Ad(G::inverse(product.suffix[0])) - e[1] * first.left_inverse;
-  for (int j = 1; j < k; ++j) {
-    out.derivative[j] =
-        e[j] * jacobians[j - 1].right_inverse - e[j + 1] * jacobians[j].left_inverse;
-  }
-  out.derivative[k] = e[k] * jacobians[k - 1].right_inverse;
-
-  const auto& b = basis.ordinary;
-  const Tangent anchor_scaled = -b[0] * product.omega[1];
-  out.weight[0] =
-      b[0] * (first.left * right_jacobian_inverse<G>(anchor_scaled)) * G::Ad(product.suffix[1]);
-  for (int j = 1; j < k; ++j)
-    out.weight[j] = (b[j] * b[j]) * SmallLU<AdMatrix>(out.derivative[j]).inverse();
-  out.weight[k] = b[k] * (jacobians[k - 1].right * last_inverse);
+  std::array<typename G::Tangent, kMaxSplineDegree + 1> unused;
+  weighted_residuals<G>(degree, basis, product, jacobians, G::Tangent::Zero(), unused, &out);
 }
 
 // The body velocity's differential in the segment's control points

@@ -228,7 +228,7 @@ ElementwiseResult<G> elementwise_two_sample_test(
   int failed = 0;
 
   constexpr std::size_t kElementsPerTask = 8;
-  const std::size_t tasks = (elements + kElementsPerTask - 1) / kElementsPerTask;
+  const std::size_t tasks = chunk_count(elements, kElementsPerTask);
   const auto run_task = [&](std::size_t task) {
     std::vector<Scalar> local_maximum(count, -std::numeric_limits<Scalar>::infinity());
     int local_failed = 0;

@@ -131,7 +131,7 @@ FitManyResult<G> fit_many(const GeodesicRegression<G>& regression,
   result.trends.resize(count);
   // Subjects in tasks of kSubjectsPerTask: one claim per task, not per fit.
   constexpr std::size_t kSubjectsPerTask = 16;
-  const std::size_t tasks = (count + kSubjectsPerTask - 1) / kSubjectsPerTask;
+  const std::size_t tasks = chunk_count(count, kSubjectsPerTask);
   const auto fit_task = [&](std::size_t task) {
     const std::size_t end = std::min(count, (task + 1) * kSubjectsPerTask);
     for (std::size_t i = task * kSubjectsPerTask; i < end; ++i) {

@@ -457,7 +457,7 @@ TwoSampleResult<G> two_sample_test(const SampleA& a, const SampleB& b,
 
   const std::size_t count = static_cast<std::size_t>(options.permutations);
   std::vector<detail::Verdict> verdicts(count, detail::Verdict::failed);
-  const std::size_t blocks = (count + detail::kBlock - 1) / detail::kBlock;
+  const std::size_t blocks = chunk_count(count, detail::kBlock);
   const Scalar threshold = observed_value * (1 - detail::kTie<Scalar>);
   const auto run_block = [&](std::size_t block) {
     std::vector<std::size_t> order;
