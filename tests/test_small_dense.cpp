@@ -184,30 +184,43 @@ TEST_CASE("SmallLU solves, inverts and takes determinants to n^2 eps", "[math][s
   }
 }
 
-// adjugate_inverse: A X - I = (A E - (delta det) I) / det, where E is the
-// adjugate's rounding (each cofactor a difference of two products: at most
-// 2 eps ||A||^2 per entry, so ||A E|| <= 6 eps ||A||^3) and delta det the
-// determinant's (three products and two sums of cofactors: <= 4 eps
-// ||A||^3); with max-norms, ||A X - I|| <= 10 eps ||A||^3 / |det|, plus
-// the test's own product A X (3 eps ||A|| ||X||).
-TEST_CASE("adjugate_inverse inverts 3 x 3 matrices to the adjugate's bound", "[math][small_lu]") {
+// inverse_3x3: by the adjugate where ||A||^3 <= 4 |det A| (residual
+// ||A X - I|| <= 48 eps ||A||^3 / |det A| <= 192 eps, max-norms, derived
+// beside it), else by SmallLU (n^2 eps ||A|| ||X|| as above); the test's
+// own product A X adds 3 eps ||A|| ||X||. A = Q diag(lambda) P^T with two
+// random orthogonal Q, P is not symmetric, so a transposed adjugate fails.
+TEST_CASE("inverse_3x3 inverts 3 x 3 matrices to the bound of the branch it takes",
+          "[math][small_lu]") {
   std::mt19937 rng(17);
-  for (int trial = 0; trial < 200; ++trial) {
+  std::uniform_real_distribution<double> spread(0.0, 1.0);
+  int adjugate_branch = 0;
+  for (int trial = 0; trial < 300; ++trial) {
     CAPTURE(trial);
-    const Eigen::VectorXd lambda = spectrum(rng, 3, trial % 3);  // kind 2: cond 1e12
-    if (lambda.cwiseAbs().minCoeff() == 0) continue;             // kind 1 is singular
-    const Dynamic q = random_orthogonal(rng, 3);
-    const Eigen::Matrix3d a = q * lambda.asDiagonal() * q.transpose();
-    const Eigen::Matrix3d x = bireg::adjugate_inverse(a);
+    // Singular values 1, 10^-a, 10^-b, a and b uniform in [0, 1]: about a
+    // third of the matrices pass the adjugate's test.
+    const Eigen::Vector3d lambda(1.0, std::pow(10.0, -spread(rng)),
+                                 (trial % 2 ? -1 : 1) * std::pow(10.0, -spread(rng)));
+    const Eigen::Matrix3d a =
+        random_orthogonal(rng, 3) * lambda.asDiagonal() * random_orthogonal(rng, 3).transpose();
+    const Eigen::Matrix3d x = bireg::inverse_3x3(a);
     const double norm = a.cwiseAbs().maxCoeff();
-    const double bound = 10 * kEps * norm * norm * norm / std::abs(lambda.prod()) +
-                         3 * kEps * norm * x.cwiseAbs().maxCoeff();
+    const double ratio = norm * norm * norm / std::abs(lambda.prod());  // |det Q| = |det P| = 1
+    const bool adjugate = ratio <= 4;
+    adjugate_branch += adjugate;
+    const double product = 3 * kEps * norm * x.cwiseAbs().maxCoeff();
+    const double bound =
+        (adjugate ? 48 * kEps * ratio : 9 * kEps * norm * x.cwiseAbs().maxCoeff()) + product;
     CHECK((a * x - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= bound);
-    const Eigen::Matrix3d expected = q * lambda.cwiseInverse().asDiagonal() * q.transpose();
-    // X - A^{-1} = A^{-1} (A X - I): at most 3 ||A^{-1}|| ||A X - I|| in max-norms.
-    CHECK((x - expected).cwiseAbs().maxCoeff() <= 3 * expected.cwiseAbs().maxCoeff() * bound);
   }
+  CHECK(adjugate_branch > 30);  // both branches are exercised
+  CHECK(adjugate_branch < 270);
+  // A rotation (its entries rounded to binary): the adjugate's branch, and
+  // the transpose to 48 eps (the residual bound at ratio 1, ||R^{-1}|| = 1)
+  // plus R^T R - I from the rounding of R's entries (3 eps an entry, times 3).
+  Eigen::Matrix3d rotation;
+  rotation << 0.36, 0.48, -0.8, -0.8, 0.6, 0.0, 0.48, 0.64, 0.6;
+  CHECK((bireg::inverse_3x3(rotation) - rotation.transpose()).cwiseAbs().maxCoeff() <= 57 * kEps);
   Eigen::Matrix3d singular;  // rows 0 and 1 parallel: the determinant is exactly 0
   singular << 1, 2, 3, 2, 4, 6, 0, 0, 1;
-  CHECK_FALSE(bireg::adjugate_inverse(singular).allFinite());
+  CHECK_FALSE(bireg::inverse_3x3(singular).allFinite());
 }

@@ -67,6 +67,13 @@ struct SplineOptions {
   // geodesic).
   Scalar tolerance = std::max(Scalar(1e-10), Scalar(64) * std::numeric_limits<Scalar>::epsilon());
   int max_iterations = 100;
+  // A step from the Gauss-Newton matrix K of earlier control points is
+  // taken when its norm is at most this times the step before it (it
+  // contracts by 1/this per step); otherwise K is assembled where the
+  // fit stands (docs/splines.md §9, "Reusing K"). In [0, 1); 0 assembles
+  // K with every step. It changes the cost, not the answer beyond the
+  // tolerance.
+  Scalar jacobian_reuse_contraction = Scalar(0.01);
   // The covariates mapped to the first and last knot, as for the geodesic
   // (RegressionOptions::interval); by default their smallest and largest.
   std::optional<std::pair<Wide, Wide>> interval;
@@ -90,8 +97,9 @@ struct SplineResult {
   std::optional<Spline<G>> spline;
   int iterations = 0;              // Gauss-Newton steps proposed (the last certifies)
   std::vector<Scalar> step_norms;  // the largest control-point component of each
-  // Times K (the Gauss-Newton matrix) was assembled: at most one per step,
-  // fewer where the steps from an earlier K contract well (splines.md §9).
+  // Times K (the Gauss-Newton matrix) was assembled, rejected trials
+  // included: fewer than the steps where steps from an earlier K contract
+  // well (splines.md §9, SplineOptions::jacobian_reuse_contraction).
   int jacobian_evaluations = 0;
   std::vector<Tangent> residuals;  // r_i = log(T(t_i)^{-1} f_i), input order
   // max_c |F_c| at the returned control points (splines.md (6)), weights
@@ -284,6 +292,9 @@ class SplineRegression {
       return Rejection{"tolerance must be a finite non-negative number"};
     }
     if (options_.max_iterations < 1) return Rejection{"max_iterations must be at least 1"};
+    if (!(options_.jacobian_reuse_contraction >= 0 && options_.jacobian_reuse_contraction < 1)) {
+      return Rejection{"jacobian_reuse_contraction must be in [0, 1)"};
+    }
     if (options_.threads < 1) {
       return Rejection{"threads must be at least 1, got " + std::to_string(options_.threads)};
     }
@@ -423,9 +434,6 @@ class SplineRegression {
   // Control points per piece of a pass over them on the pool (an exp and
   // a product each: 1024 take about 30 us on SO(3)).
   static constexpr std::size_t kControlPointPiece = 1024;
-  // The contraction a step from K assembled at earlier control points
-  // must show against the step before it to be taken (docs/splines.md §9).
-  static constexpr Scalar kReuseContraction = Scalar(0.01);
 
   // body(piece) for every piece in [0, pieces), on the pool's threads
   // when there is one.
@@ -717,14 +725,14 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   constexpr int kHalvings = 30;
   // K is reused while it still contracts (docs/splines.md §9, "Reusing
   // K"): `assembled_here` says whether the factors are K's at `points`;
-  // a step from older factors is taken only if it contracts by
-  // kReuseContraction against the step before it, and otherwise K is
-  // assembled at `points` and the step recomputed (once per fit: after a
-  // poor reuse K is assembled with every step). The decisions depend on
-  // the steps' norms alone, so the bits still do not depend on the
-  // thread count.
-  bool factored = false, assembled_here = true, reuse = true;
-  Scalar previous_norm = 0;  // the last step taken (0: none yet)
+  // a step from older factors is taken only if its norm is at most
+  // jacobian_reuse_contraction times the last step taken, and otherwise
+  // K is assembled at `points` and the step recomputed (after which K is
+  // assembled with every step). The decisions depend on the steps' norms
+  // alone, so the bits still do not depend on the thread count.
+  const Scalar reuse_contraction = options_.jacobian_reuse_contraction;
+  bool factored = false, assembled_here = true, reuse = reuse_contraction > 0;
+  Scalar previous_norm = 0;  // the last step taken, as taken (0: none yet)
   const auto assemble_here = [&] {
     evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
     ++result.jacobian_evaluations;
@@ -743,7 +751,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
     Scalar norm = 0;
     for (const Tangent& s : step)
       norm = std::max(norm, s.template lpNorm<Eigen::Infinity>());
-    const bool contracts = solved && norm <= kReuseContraction * previous_norm;
+    const bool contracts = solved && norm <= reuse_contraction * previous_norm;
     if (!assembled_here && !contracts) {
       reuse = false;
       assemble_here();
@@ -761,7 +769,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       break;
     }
     bool accepted = false;
-    Scalar scale = 1;
+    Scalar scale = 1, taken = 0;
     for (int halving = 0; halving <= kHalvings && !accepted; ++halving, scale /= 2) {
       run_ranges(chunk_pool, points.size(), kControlPointPiece,
                  [&](std::size_t begin, std::size_t end) {
@@ -778,6 +786,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       result.jacobian_evaluations += with_jacobian;
       if (next.finite && next.merit < current.merit) {
         accepted = true;
+        taken = scale * norm;
         points.swap(trial);
         result.residuals.swap(trial_residuals);
         std::swap(current, next);
@@ -808,7 +817,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       if (!floor) result.message = no_descent_message(result.residuals, points, step);
       break;
     }
-    previous_norm = norm;
+    previous_norm = taken;
   }
   for (const Tangent& f : current.force)
     result.equation_norm = std::max(result.equation_norm, f.norm());

@@ -223,7 +223,7 @@ struct SO3 {
            small_angle::one_minus_half_x_cot_half_x_over_x2_from_square(omega.squaredNorm()) *
                hat_squared(omega);
   }
-  // Both at once: W, W^2 and the angle are shared.
+  // Both at once: W, W^2 and the squared angle are shared.
   static RightJacobianPair<AdMatrix> right_jacobian_pair(const Tangent& omega) {
     const Scalar squared_angle = omega.squaredNorm();
     const Algebra w = hat(omega);

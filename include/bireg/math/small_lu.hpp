@@ -137,19 +137,29 @@ class SmallLU {
   Eigen::Matrix<int, N, 1> pivot_;
 };
 
-// The inverse of a fixed-size 3 x 3 matrix by its adjugate, adj(A) / det A:
-// about 40 operations and one division, where the pivoted elimination's
-// data-dependent branches cost ~50 ns (SmallLU, 2026-11-29). Its error is
-// O(cond(A) eps) like LU's for the well-conditioned matrices it is used on
-// (the spline's interior D_j, splines.md §5); a singular A gives a
-// determinant of zero and a result that is not finite, which the caller
-// sees (as SmallLU's).
+// The inverse of a fixed-size 3 x 3 matrix: by its adjugate, adj(A) /
+// det A (about 40 operations and one division, where the pivoted
+// elimination's data-dependent branches cost ~50 ns: SmallLU, 2026-11-29)
+// where that is accurate, else by SmallLU. With max-norms and to first
+// order, the adjugate's residual is ||A X - I|| <= 48 eps ||A||^3 /
+// |det A|: a cofactor (two rounded products and a rounded difference) is
+// off by at most 4 eps ||A||^2, so A times the adjugate's errors by 12 eps
+// ||A||^3; the determinant carries those through its first row (12) and
+// rounds its three products and two sums (18); the division adds 3 eps
+// ||A|| ||X|| <= 6 eps ||A||^3 / |det A|. Where ||A||^3 <= 4 |det A| that
+// is at most 192 eps: the near-orthogonal
+// matrices it is meant for (the spline's interior D_j on SO(3), B_j times
+// a matrix near I; splines.md §5). A matrix whose entries differ in scale
+// (SE(2)'s translations in small units) fails the test and gets the
+// pivoted LU, whose error grows like cond(A) eps rather than cond^2. A
+// singular A gives a result that is not finite, as SmallLU's.
 template <class Matrix>
-Eigen::Matrix<typename Matrix::Scalar, 3, 3> adjugate_inverse(const Matrix& a) {
+Eigen::Matrix<typename Matrix::Scalar, 3, 3> inverse_3x3(const Matrix& a) {
   static_assert(Matrix::RowsAtCompileTime == 3 && Matrix::ColsAtCompileTime == 3);
   using Scalar = typename Matrix::Scalar;
+  using std::abs;
   Eigen::Matrix<Scalar, 3, 3> adjugate;
-  // Column j of A's cofactors is row j of the adjugate.
+  // Row j of the adjugate is column j of A's cofactors.
   adjugate(0, 0) = a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1);
   adjugate(0, 1) = a(0, 2) * a(2, 1) - a(0, 1) * a(2, 2);
   adjugate(0, 2) = a(0, 1) * a(1, 2) - a(0, 2) * a(1, 1);
@@ -161,7 +171,9 @@ Eigen::Matrix<typename Matrix::Scalar, 3, 3> adjugate_inverse(const Matrix& a) {
   adjugate(2, 2) = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
   const Scalar determinant =
       a(0, 0) * adjugate(0, 0) + a(0, 1) * adjugate(1, 0) + a(0, 2) * adjugate(2, 0);
-  return adjugate / determinant;
+  const Scalar norm = a.cwiseAbs().maxCoeff();
+  if (Scalar(4) * abs(determinant) >= norm * norm * norm) return adjugate / determinant;
+  return SmallLU<Eigen::Matrix<Scalar, 3, 3>>(a).inverse();
 }
 
 }  // namespace bireg

@@ -61,8 +61,9 @@ struct ControlPointDifferentials {
 // The terms W_j r_i, j = 0..k, of the estimating equations for one
 // observation with residual r, and D_j and W_j into `matrices` when given
 // (for K and the covariance). The terms are formed from products of
-// vectors where a closed form allows (W_0 r and W_k r), and by solving
-// D_j x = r for the interior ones, so that F costs no 3 x 3 inverse; they
+// vectors where a closed form allows (W_0 r and W_k r); the interior ones
+// solve D_j x = r (by LU, or for d = 3 by inverse_3x3's adjugate, which
+// costs less than LU's branches). They
 // are the same arithmetic whether or not the matrices are asked for, so F
 // does not depend on whether K is assembled with it. `jacobians` points at
 // the Jacobians of the segment's first increment (Omega_{i+1}); `product`
@@ -99,7 +100,7 @@ void weighted_residuals(int degree, const SplineBasis<typename G::Scalar>& basis
   }
   const IncrementJacobians<G>& first = jacobians[0];
   const IncrementJacobians<G>& last = jacobians[k - 1];
-  // W_0 r = s J_l(Omega_1) J_l(s Omega_1)^{-1} Ad_{S_1} r, s = b_0, with
+  // W_0 r = s J_l(Omega_1) J_l(s Omega_1)^{-1} Ad_{S_1} r, s = B_0, with
   // J_l(s Omega_1)^{-1} = J_r(-s Omega_1)^{-1}.
   const AdMatrix anchor_inverse = right_jacobian_inverse<G>((-b[0] * product.omega[1]).eval());
   const AdMatrix carry = G::Ad(product.suffix[1]);
@@ -111,7 +112,7 @@ void weighted_residuals(int degree, const SplineBasis<typename G::Scalar>& basis
         e[j] * jacobians[j - 1].right_inverse - e[j + 1] * jacobians[j].left_inverse;
     const auto square = b[j] * b[j];
     if constexpr (AdMatrix::RowsAtCompileTime == 3) {
-      const AdMatrix inverse = adjugate_inverse(derivative);
+      const AdMatrix inverse = inverse_3x3(derivative);
       terms[j] = square * (inverse * residual);
       if (matrices) matrices->weight[j] = square * inverse;
     } else {
