@@ -59,28 +59,28 @@ Scalar polynomial(const std::array<Scalar, Count>& coefficients, Scalar x) {
 }
 
 namespace detail {
-// Taylor coefficients of (x - sin x)/x^3 in powers of x^2: (-1)^k / (2k+3)!.
+// (-1)^k / (2k + first)!, k = 0..Count-1: the Taylor coefficients in powers
+// of x^2 of (1 - cos x)/x^2 (first = 2) and of (x - sin x)/x^3 (first = 3).
 template <std::size_t Count>
-constexpr std::array<long double, Count> x_minus_sin_series() {
+constexpr std::array<long double, Count> alternating_factorial_series(int first) {
   std::array<long double, Count> c{};
-  long double factorial = 6.0L;  // 3!
+  long double factorial = 1.0L;
+  for (int n = 2; n <= first; ++n)
+    factorial *= static_cast<long double>(n);
   for (std::size_t k = 0; k < Count; ++k) {
     c[k] = (k % 2 == 0 ? 1.0L : -1.0L) / factorial;
-    factorial *= static_cast<long double>((2 * k + 4) * (2 * k + 5));
+    const long double next = static_cast<long double>(2 * k) + first + 1;
+    factorial *= next * (next + 1);
   }
   return c;
 }
-
-// Taylor coefficients of (1 - cos x)/x^2 in powers of x^2: (-1)^k / (2k+2)!.
+template <std::size_t Count>
+constexpr std::array<long double, Count> x_minus_sin_series() {
+  return alternating_factorial_series<Count>(3);
+}
 template <std::size_t Count>
 constexpr std::array<long double, Count> one_minus_cos_series() {
-  std::array<long double, Count> c{};
-  long double factorial = 2.0L;  // 2!
-  for (std::size_t k = 0; k < Count; ++k) {
-    c[k] = (k % 2 == 0 ? 1.0L : -1.0L) / factorial;
-    factorial *= static_cast<long double>((2 * k + 3) * (2 * k + 4));
-  }
-  return c;
+  return alternating_factorial_series<Count>(2);
 }
 
 // Taylor coefficients of (1 - (x/2) cot(x/2))/x^2 in powers of x^2. From
