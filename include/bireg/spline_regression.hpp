@@ -667,8 +667,10 @@ std::optional<Rejection> SplineRegression<G>::prepare(const Observations& observ
   out.order.resize(n);
   std::iota(out.order.begin(), out.order.end(), std::size_t(0));
   const std::vector<Scalar>& t = out.problem.t;
-  std::stable_sort(out.order.begin(), out.order.end(),
-                   [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+  if (!std::is_sorted(t.begin(), t.end())) {  // a time series usually is: nothing to do
+    std::stable_sort(out.order.begin(), out.order.end(),
+                     [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+  }
   if (auto rejection = check_schoenberg_whitney(out.problem, out.order, out.knots)) {
     return rejection;
   }
@@ -709,7 +711,6 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
   Result result;
   result.residuals.resize(n);
   BlockBandedMatrix<AdMatrix, Tangent> jacobian(knots.control_points, std::size_t(options_.degree));
-  BlockBandedMatrix<AdMatrix, Tangent> trial_jacobian = jacobian;
   Evaluation current(knots.control_points), next(knots.control_points);
   evaluate(observations, problem, knots, points, result.residuals, &jacobian, scratch, current);
   result.jacobian_evaluations = 1;
@@ -778,12 +779,17 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
                  });
       // The full step's trial assembles K as it goes unless this K is to
       // be reused there; a halved one only F, and K is assembled once it
-      // is taken.
+      // is taken. The trial's K overwrites the factors in place: the step
+      // is already solved, and if the trial is refused a halved one
+      // needs no K (with_jacobian implies assembled_here, so no retry
+      // from these factors follows), which spares a second K of
+      // M (2k + 1) blocks, copied and page-faulted serially.
       const bool full_step = halving == 0;
       const bool with_jacobian = full_step && !(reuse && contracts);
       evaluate(observations, problem, knots, trial, trial_residuals,
-               with_jacobian ? &trial_jacobian : nullptr, scratch, next);
+               with_jacobian ? &jacobian : nullptr, scratch, next);
       result.jacobian_evaluations += with_jacobian;
+      if (with_jacobian) factored = false;
       if (next.finite && next.merit < current.merit) {
         accepted = true;
         taken = scale * norm;
@@ -791,8 +797,6 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
         result.residuals.swap(trial_residuals);
         std::swap(current, next);
         if (with_jacobian) {
-          std::swap(jacobian, trial_jacobian);
-          factored = false;
           assembled_here = true;
         } else if (full_step) {
           assembled_here = false;
