@@ -591,6 +591,29 @@ TEST_CASE("Spline fit reports spans and residuals near the log's cut locus", "[s
   CHECK(wide.status == bireg::Status::no_descent);
   CHECK(wide.message.find("half turn") != std::string::npos);
   CHECK(wide.message.find("try a narrower knot spacing") != std::string::npos);
+  CHECK(wide.message.find("swing") == std::string::npos);
+}
+
+// The opposite failure: 40 observations with 0.2 rad of noise per axis
+// over four cubic spans. An end control point's basis is at most 1/6 over
+// its one span, so its least-squares estimate varies by about 12 times
+// the noise per axis (12.3 for this design in R^3, from (B^T B)^{-1}), an
+// end increment past the half turn; the data around it move far less,
+// and the message says that the data determine the control points too
+// weakly there, not that the knots are too sparse.
+TEST_CASE("Spline fit: control points swinging out beyond sparse noisy data are named as such",
+          "[spline]") {
+  std::mt19937 rng(13);
+  const bireg::Spline<SO3> truth(3, 0.0, 1.0, bireg_test::random_points<SO3>(rng, 7, 0.4));
+  const Samples<SO3> data = bireg_test::sample(truth, 40, 0.2, rng);
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = 1.0;
+  const auto fit = bireg::SplineRegression<SO3>(options).fit(data.f, data.t);
+  INFO(fit.message);
+  REQUIRE(fit.status == bireg::Status::no_descent);
+  CHECK(fit.message.find("swing out beyond the data") != std::string::npos);
+  CHECK(fit.message.find("try a wider knot spacing") != std::string::npos);
+  CHECK(fit.message.find("narrower") == std::string::npos);
 }
 
 // The Exp-stepped iteration P_c <- P_c exp(lambda F_c) of splines.md §7, run

@@ -564,12 +564,21 @@ class SplineRegression {
   // a step far larger than the data's spread with fewer than three
   // observations per control point (nearly singular equations: knots too
   // dense for the data); consecutive control points near a half turn apart
-  // (a span would have to turn past the increments' principal log: one
-  // cubic segment over a motion of a few radians needs control points far
-  // outside the data); a large step alone.
-  static std::string no_descent_message(const std::vector<Tangent>& residuals,
-                                        const std::vector<Element>& points,
-                                        const std::vector<Tangent>& step) {
+  // (a span would have to turn past the increments' principal log), told
+  // apart by how far the observations around the span move: about as far
+  // as the control points when one cubic segment covers a motion of a few
+  // radians (knots too sparse), far less when the control points swing out
+  // beyond the data (few or noisy observations where a control point's
+  // basis is small, as at the ends: knots too dense), the control points'
+  // turn more than 1.5 times the observations' (B-spline control points
+  // exceed a smooth motion by less: by 1.5 at a period of four spans); a
+  // large step alone.
+  template <class Observations>
+  std::string no_descent_message(const Observations& observations, const Problem<Scalar>& problem,
+                                 const Knots& knots, const std::vector<std::size_t>& order,
+                                 const std::vector<Tangent>& residuals,
+                                 const std::vector<Element>& points,
+                                 const std::vector<Tangent>& step) const {
     constexpr Scalar kHalfTurn = Scalar(3.14159265358979323846);
     std::ptrdiff_t far = -1;
     Scalar farthest = 0;
@@ -606,15 +615,50 @@ class SplineRegression {
       if (turn > widest) span = j, widest = turn;
     }
     if (widest > kBeyondDomainAngle<Scalar>) {
-      return why + "control points " + std::to_string(span - 1) + " and " + std::to_string(span) +
-             " are " + std::to_string(double(widest)) +
-             " rad apart, near the half turn where their increment's log jumps: the motion "
-             "within a knot span is too large for the spline's control points; try a narrower "
-             "knot spacing";
+      const std::string apart = "control points " + std::to_string(span - 1) + " and " +
+                                std::to_string(span) + " are " + std::to_string(double(widest)) +
+                                " rad apart, near the half turn where their increment's log "
+                                "jumps";
+      const Scalar motion = motion_around(observations, problem, knots, order, span);
+      if (widest > Scalar(1.5) * motion) {
+        return why + apart + ", while the observations around them move " +
+               std::to_string(double(motion)) +
+               " rad: the control points swing out beyond the data, which determine them only "
+               "weakly there (a cubic's end control points carry a basis weight of at most 1/6 "
+               "and vary by about 12 times the noise at 10 observations per span); try a wider "
+               "knot spacing, a lower degree or more observations";
+      }
+      return why + apart +
+             ": the motion within a knot span is too large for the spline's control points; try "
+             "a narrower knot spacing";
     }
     if (largest > 1) return why + dense + "try another knot spacing";
     return why + "the largest residual is " + std::to_string(double(farthest)) +
            " rad; the equations have no solution reachable from the start at this knot spacing";
+  }
+
+  // How far the observations move around the span between control points
+  // span - 1 and span: the spectral radius of ad of log(f_a^{-1} f_b), f_a
+  // and f_b the observations nearest the ends of [g_{span-1} - h, g_span +
+  // h] within the data, g_c = (c - (k - 1)/2) h the Greville abscissae
+  // (chart_start's anchors); 0 when both ends are the same observation.
+  template <class Observations>
+  Scalar motion_around(const Observations& observations, const Problem<Scalar>& problem,
+                       const Knots& knots, const std::vector<std::size_t>& order,
+                       std::size_t span) const {
+    const Scalar shift = Scalar(options_.degree - 1) / 2;
+    const auto nearest = [&](Scalar abscissa) {
+      const Scalar at = std::clamp(abscissa, Scalar(0), Scalar(1));
+      const auto after = std::partition_point(order.begin(), order.end(),
+                                              [&](std::size_t i) { return problem.t[i] < at; });
+      if (after == order.end()) return order.back();
+      if (after == order.begin()) return *after;
+      return at - problem.t[*(after - 1)] <= problem.t[*after] - at ? *(after - 1) : *after;
+    };
+    const std::size_t a = nearest((Scalar(span - 1) - shift - 1) * knots.h);
+    const std::size_t b = nearest((Scalar(span) - shift + 1) * knots.h);
+    if (a == b) return 0;
+    return ad_spectral_radius<G>(G::log(G::compose(G::inverse(observations[a]), observations[b])));
   }
 
   // What fit() and equations() work on, checked: the problem, the pool (from
@@ -818,7 +862,9 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
       // data's precision, otherwise outside the estimator's domain.
       const bool floor = norm <= std::sqrt(std::numeric_limits<Scalar>::epsilon());
       result.status = floor ? Status::rounding_floor : Status::no_descent;
-      if (!floor) result.message = no_descent_message(result.residuals, points, step);
+      if (!floor)
+        result.message = no_descent_message(observations, problem, knots, scratch.order,
+                                            result.residuals, points, step);
       break;
     }
     previous_norm = taken;
