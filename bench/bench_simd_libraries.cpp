@@ -319,8 +319,7 @@ struct Kernel {
       std::size_t begin, std::size_t end, const Element& g0_inverse, const Prepared& forward,
       const Prepared& backward, Tangent* residuals) {
     constexpr double kPi = 3.141592653589793238462643383279502884;
-    static constexpr auto kExpSeries = bireg::small_angle::in_precision<double>(
-        bireg::small_angle::detail::x_minus_sin_series<14>());
+    constexpr const auto& kExpSeries = bireg::small_angle::kXMinusSinSeries<double>;
     static constexpr auto kLogSeries = bireg::small_angle::in_precision<double>(
         bireg::small_angle::detail::one_minus_half_cot_series<20>());
 

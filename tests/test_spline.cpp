@@ -103,16 +103,12 @@ TEST_CASE("Spline control-point differentials (4) and the weights B_c^2 D_c^{-1}
   const auto points = random_points<SO3>(rng, 6, 0.6);
   for (const int k : {1, 2, 3}) {
     const bireg::Spline<SO3> curve(k, 0.0, 1.0, points);
-    std::vector<bireg::IncrementJacobians<SO3>> jacobians;
-    for (const auto& omega : curve.increments())
-      jacobians.push_back(bireg::IncrementJacobians<SO3>::of(omega));
     for (const double t : {0.37, 1.02, 1.99, 2.5}) {
-      const auto at = curve.position(t);
-      const auto basis = bireg::spline_basis(k, at.u);
-      bireg::SegmentProduct<SO3> product;
-      bireg::evaluate_segment<SO3>(k, &curve.increments()[at.segment], basis, product);
+      bireg::SegmentAt<SO3> segment;
+      bireg::segment_at(curve, t, segment);
+      const auto& [at, basis, product, jacobians] = segment;
       bireg::ControlPointDifferentials<SO3> out;
-      bireg::control_point_differentials<SO3>(k, basis, product, &jacobians[at.segment], out);
+      bireg::control_point_differentials<SO3>(k, basis, product, jacobians.data(), out);
       for (int j = 0; j <= k; ++j) {
         const std::size_t c = at.segment + std::size_t(j);
         SO3::AdMatrix numeric;
@@ -149,21 +145,17 @@ TEST_CASE("Spline F terms without matrices equal W_j r and do not depend on K", 
     const auto points = random_points<G>(rng, 6, 0.6);
     for (const int k : {1, 2, 3}) {
       const bireg::Spline<G> curve(k, 0.0, 1.0, points);
-      std::vector<bireg::IncrementJacobians<G>> jacobians;
-      for (const auto& omega : curve.increments())
-        jacobians.push_back(bireg::IncrementJacobians<G>::of(omega));
       for (const double t : {0.37, 1.02, 1.99, 2.5}) {
-        const auto at = curve.position(t);
-        const auto basis = bireg::spline_basis(k, at.u);
-        bireg::SegmentProduct<G> product;
-        bireg::evaluate_segment<G>(k, &curve.increments()[at.segment], basis, product);
+        bireg::SegmentAt<G> segment;
+        bireg::segment_at(curve, t, segment);
+        const auto& [at, basis, product, jacobians] = segment;
         typename G::Tangent r;
         for (Eigen::Index a = 0; a < r.size(); ++a)
           r[a] = normal(rng);
         std::array<typename G::Tangent, bireg::kMaxSplineDegree + 1> alone, with;
         bireg::ControlPointDifferentials<G> matrices;
-        bireg::weighted_residuals<G>(k, basis, product, &jacobians[at.segment], r, alone);
-        bireg::weighted_residuals<G>(k, basis, product, &jacobians[at.segment], r, with, &matrices);
+        bireg::weighted_residuals<G>(k, basis, product, jacobians.data(), r, alone);
+        bireg::weighted_residuals<G>(k, basis, product, jacobians.data(), r, with, &matrices);
         for (int j = 0; j <= k; ++j) {
           INFO(G::name << " degree " << k << " t " << t << " j " << j);
           CHECK(alone[std::size_t(j)] == with[std::size_t(j)]);

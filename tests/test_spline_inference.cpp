@@ -60,13 +60,9 @@ TEST_CASE("Spline velocity differential (11) against differences of the curve", 
     const std::vector<SE3::Element> points = random_points<SE3>(rng, 7, 0.6);
     const bireg::Spline<SE3> curve(k, 0.5, 0.7, points);
     for (const double t : {0.5, 1.13, 2.2, 3.3 - 1e-9}) {
-      const auto at = curve.position(t);
-      const auto basis = bireg::spline_basis(k, at.u);
-      bireg::SegmentProduct<SE3> product;
-      bireg::evaluate_segment<SE3>(k, &curve.increments()[at.segment], basis, product);
-      std::vector<bireg::IncrementJacobians<SE3>> jacobians;
-      for (int j = 0; j < k; ++j)
-        jacobians.push_back(bireg::IncrementJacobians<SE3>::of(curve.increments()[at.segment + j]));
+      bireg::SegmentAt<SE3> segment;
+      bireg::segment_at(curve, t, segment);
+      const auto& [at, basis, product, jacobians] = segment;
       std::array<SE3::AdMatrix, bireg::kMaxSplineDegree + 1> v;
       bireg::velocity_differentials<SE3>(k, curve.knot_spacing(), basis, product, jacobians.data(),
                                          v);

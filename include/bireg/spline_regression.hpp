@@ -435,26 +435,6 @@ class SplineRegression {
   // a product each: 1024 take about 30 us on SO(3)).
   static constexpr std::size_t kControlPointPiece = 1024;
 
-  // body(piece) for every piece in [0, pieces), on the pool's threads
-  // when there is one.
-  template <class Body>
-  static void run_pieces(ChunkPool* pool, std::size_t pieces, const Body& body) {
-    if (pool) {
-      pool->run(pieces, body);
-    } else {
-      for (std::size_t piece = 0; piece < pieces; ++piece)
-        body(piece);
-    }
-  }
-
-  // body(begin, end) over [0, n) in ranges of `size` (the last one
-  // short), on the pool's threads when there is one.
-  template <class Body>
-  static void run_ranges(ChunkPool* pool, std::size_t n, std::size_t size, const Body& body) {
-    run_pieces(pool, chunk_count(n, size),
-               [&](std::size_t piece) { body(piece * size, std::min(n, (piece + 1) * size)); });
-  }
-
   // The residuals, F and sum |F|^2 at `points` into `evaluation`; K too
   // when `jacobian`. Each chunk of observations (in covariate order, so
   // that it touches a run of control points) sums into its own partial,

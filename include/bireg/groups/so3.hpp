@@ -253,7 +253,7 @@ struct SO3 {
     basis.theta2 = omega.squaredNorm();
     basis.theta = sqrt(basis.theta2);
     basis.a = hat(omega);
-    basis.a2 = omega * omega.transpose() - basis.theta2 * AdMatrix::Identity();
+    basis.a2 = hat_squared(omega);
     basis.n1 = basis.n2 = AdMatrix::Zero();
     return basis;
   }

@@ -154,19 +154,20 @@ Scalar one_minus_cos_over_x2_from_square(Scalar x2) {
 // (x - sin x = 1.09 at x = 2). Below 2 the series in x^2 converges with ratio
 // x^2/((2k+4)(2k+5)); 14 terms leave 4^14/31! < 1e-25 at x = 2.
 template <class Scalar>
+inline constexpr auto kXMinusSinSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
+
+template <class Scalar>
 Scalar x_minus_sin_over_x3(Scalar x) {
   using std::abs;
   using std::sin;
-  static constexpr auto kSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
-  if (abs(x) < Scalar(2)) return polynomial(kSeries, x * x);
+  if (abs(x) < Scalar(2)) return polynomial(kXMinusSinSeries<Scalar>, x * x);
   return (x - sin(x)) / (x * x * x);
 }
 // The same from x^2 (x >= 0 its square root).
 template <class Scalar>
 Scalar x_minus_sin_over_x3_from_square(Scalar x2) {
   using std::sqrt;
-  static constexpr auto kSeries = in_precision<Scalar>(detail::x_minus_sin_series<14>());
-  if (x2 < Scalar(4)) return polynomial(kSeries, x2);
+  if (x2 < Scalar(4)) return polynomial(kXMinusSinSeries<Scalar>, x2);
   return x_minus_sin_over_x3(sqrt(x2));
 }
 

@@ -550,8 +550,7 @@ ForceSums<SE3<Scalar>> closed_form_sums(
   using V = detail::Vec<Scalar>;
   const detail::Tag<Scalar> d;
   const std::size_t lane_count = hn::Lanes(d);
-  static constexpr auto kExpSeries =
-      small_angle::in_precision<Scalar>(small_angle::detail::x_minus_sin_series<14>());
+  constexpr const auto& kExpSeries = small_angle::kXMinusSinSeries<Scalar>;
   static constexpr auto kLogSeries =
       small_angle::in_precision<Scalar>(small_angle::detail::one_minus_half_cot_series<20>());
 

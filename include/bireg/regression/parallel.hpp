@@ -159,6 +159,26 @@ class ChunkPool {
   std::size_t busy_ = 0;
 };
 
+// body(piece) for every piece in [0, pieces): on the pool's threads when
+// there is one, in order on the caller's otherwise.
+template <class Body>
+void run_pieces(ChunkPool* pool, std::size_t pieces, const Body& body) {
+  if (pool) {
+    pool->run(pieces, body);
+  } else {
+    for (std::size_t piece = 0; piece < pieces; ++piece)
+      body(piece);
+  }
+}
+
+// body(begin, end) over [0, n) in ranges of `size` (the last one short),
+// on the pool's threads when there is one.
+template <class Body>
+void run_ranges(ChunkPool* pool, std::size_t n, std::size_t size, const Body& body) {
+  run_pieces(pool, chunk_count(n, size),
+             [&](std::size_t piece) { body(piece * size, std::min(n, (piece + 1) * size)); });
+}
+
 // A once-per-fit pass over observations [0, n) (the observation check, the
 // chart, the Gauss-Newton moments, the diagnostics) by chunks:
 // body(begin, end) returns a chunk's Partial, and combine(total, next)
@@ -174,12 +194,7 @@ Partial reduce_chunks(std::size_t n, ChunkPool* pool, const Body& body, const Co
   const auto run_chunk = [&](std::size_t chunk) {
     partials[chunk] = body(chunk * kChunkSize, std::min(n, (chunk + 1) * kChunkSize));
   };
-  if (pool) {
-    pool->run(chunks, run_chunk);
-  } else {
-    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
-      run_chunk(chunk);
-  }
+  run_pieces(pool, chunks, run_chunk);
   Partial total = std::move(partials[0]);
   for (std::size_t chunk = 1; chunk < chunks; ++chunk)
     combine(total, partials[chunk]);

@@ -174,12 +174,7 @@ class BlockBandedMatrix {
   // and a split.
   template <class Body>
   void on_both_sides(ChunkPool* pool, const Body& body) const {
-    if (pool && split_ < rows_) {
-      pool->run(2, body);
-    } else {
-      body(0);
-      body(1);
-    }
+    run_pieces(split_ < rows_ ? pool : nullptr, 2, body);
   }
 
   bool invert_pivot(std::size_t c) {

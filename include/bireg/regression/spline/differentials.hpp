@@ -50,6 +50,29 @@ struct IncrementJacobians {
   }
 };
 
+// One covariate's segment of a spline: the knot position, the basis, the
+// segment's product of exponentials, and the Jacobians of its first k
+// increments (for the differentials below, away from the fit's loop,
+// which shares them across observations).
+template <class G>
+struct SegmentAt {
+  KnotPosition<typename G::Scalar> at;
+  SplineBasis<typename G::Scalar> basis;
+  SegmentProduct<G> product;
+  std::array<IncrementJacobians<G>, kMaxSplineDegree> jacobians;
+};
+
+template <class G>
+void segment_at(const Spline<G>& spline, typename G::Scalar t, SegmentAt<G>& out) {
+  const int k = spline.degree();
+  out.at = spline.position(t);
+  out.basis = spline_basis(k, out.at.u);
+  const typename G::Tangent* increments = &spline.increments()[out.at.segment];
+  evaluate_segment<G>(k, increments, out.basis, out.product);
+  for (int j = 0; j < k; ++j)
+    out.jacobians[std::size_t(j)] = IncrementJacobians<G>::of(increments[j]);
+}
+
 // D_j and W_j, j = 0..k, for one observation.
 template <class G>
 struct ControlPointDifferentials {

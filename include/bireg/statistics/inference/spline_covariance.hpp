@@ -95,27 +95,6 @@ SplineCovariance<G> refused(CovarianceStatus status, std::string message) {
   return c;
 }
 
-// One observation's segment at covariate t: the basis, the product, and
-// the Jacobians of the segment's increments.
-template <class G>
-struct SegmentAt {
-  KnotPosition<typename G::Scalar> at;
-  SplineBasis<typename G::Scalar> basis;
-  SegmentProduct<G> product;
-  std::array<IncrementJacobians<G>, kMaxSplineDegree> jacobians;
-};
-
-template <class G>
-void segment_at(const Spline<G>& spline, typename G::Scalar t, SegmentAt<G>& out) {
-  const int k = spline.degree();
-  out.at = spline.position(t);
-  out.basis = spline_basis(k, out.at.u);
-  const typename G::Tangent* increments = &spline.increments()[out.at.segment];
-  evaluate_segment<G>(k, increments, out.basis, out.product);
-  for (int j = 0; j < k; ++j)
-    out.jacobians[std::size_t(j)] = IncrementJacobians<G>::of(increments[j]);
-}
-
 // sum_{j,l} A_j Cov(delta_{i+j}, delta_{i+l}) A_l^T over t's control points.
 template <class G>
 typename G::AdMatrix segment_covariance(
@@ -190,7 +169,7 @@ SplineCovariance<G> spline_covariance(const SplineResult<G>& fit, const Observat
   std::vector<Tangent> residuals(n);
   BlockBandedMatrix<Scalar1, Scalar1> h(m, k);
   std::vector<Scalar> h2(m * band, Scalar(0));
-  spline_covariance_detail::SegmentAt<G> segment;
+  SegmentAt<G> segment;
   for (std::size_t i = 0; i < n; ++i) {
     const Scalar t = static_cast<Scalar>(covariates[i]);
     const KnotPosition<Scalar> at = spline.position(t);
@@ -259,7 +238,7 @@ SplineCovariance<G> spline_covariance(const SplineResult<G>& fit, const Observat
   for (std::size_t i = 0; i < n; ++i) {
     const Scalar w = problem.w[i];
     if (!(w > 0)) continue;
-    spline_covariance_detail::segment_at(spline, static_cast<Scalar>(covariates[i]), segment);
+    segment_at(spline, static_cast<Scalar>(covariates[i]), segment);
     control_point_differentials<G>(int(k), segment.basis, segment.product, segment.jacobians.data(),
                                    differentials);
     const AdMatrix left_inverse = right_jacobian_inverse<G>((-residuals[i]).eval());
