@@ -267,6 +267,70 @@ TEST_CASE("Spline fit in R^3 is least-squares B-spline regression", "[spline]") 
   }
 }
 
+// With the roughness penalty (splines.md §12) the equations in R^3 are the
+// penalised normal equations (B^T W B + lambda D_2^T D_2) P = B^T W F,
+// weights normalised to a largest of 1, D_2 the second differences of the
+// control points; solved here densely, at penalties from barely felt to
+// dominant. Tolerance as above (linear equations: one Gauss-Newton step).
+TEST_CASE("Spline fit in R^3 with a roughness penalty solves the penalised normal equations",
+          "[spline]") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<R3::Element> f;
+  std::vector<double> t, w;
+  for (int i = 0; i < 80; ++i) {
+    t.push_back(10 * uniform(rng));
+    w.push_back(0.5 + uniform(rng));
+    f.push_back(R3::Element(std::sin(t.back()), std::cos(0.7 * t.back()), 0.1 * t.back()) +
+                bireg_test::normal_tangent<R3::Tangent>(rng, 0.1));
+  }
+  const double largest_weight = *std::max_element(w.begin(), w.end());
+  for (const int k : {2, 3}) {
+    for (const double lambda : {1e-3, 1.0, 1e3}) {
+      bireg::SplineOptions<double> options;
+      options.degree = k;
+      options.knot_spacing = 0.5;
+      options.roughness_penalty = lambda;
+      const auto fit = bireg::SplineRegression<R3>(options).fit(f, t, w);
+      INFO("degree " << k << " lambda " << lambda);
+      REQUIRE(fit.ok());
+      const auto& curve = *fit.spline;
+      const std::size_t m = curve.control_points().size();
+      Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(m, m), rhs = Eigen::MatrixXd::Zero(m, 3);
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        const auto at = curve.position(t[i]);
+        const auto basis = bireg::spline_basis(k, at.u);
+        const double weight = w[i] / largest_weight;
+        for (int a = 0; a <= k; ++a) {
+          rhs.row(at.segment + a) += weight * basis.ordinary[a] * f[i].transpose();
+          for (int b = 0; b <= k; ++b)
+            normal(at.segment + a, at.segment + b) +=
+                weight * basis.ordinary[a] * basis.ordinary[b];
+        }
+      }
+      Eigen::MatrixXd second = Eigen::MatrixXd::Zero(m - 2, m);
+      for (std::size_t c = 0; c + 2 < m; ++c)
+        second.row(c).segment(c, 3) << 1, -2, 1;
+      normal += lambda * second.transpose() * second;
+      const Eigen::MatrixXd solution = normal.ldlt().solve(rhs);
+      const double scale = solution.cwiseAbs().maxCoeff();
+      for (std::size_t c = 0; c < m; ++c)
+        CHECK((curve.control_points()[c] - solution.row(c).transpose()).norm() < 1e-12 * scale);
+    }
+  }
+  bireg::SplineOptions<double> options;
+  options.roughness_penalty = -1;
+  CHECK(bireg::SplineRegression<R3>(options).fit(f, t).message ==
+        "roughness_penalty must be a finite non-negative number");
+  options.roughness_penalty = std::numeric_limits<double>::quiet_NaN();
+  CHECK(bireg::SplineRegression<R3>(options).fit(f, t).message ==
+        "roughness_penalty must be a finite non-negative number");
+  options.roughness_penalty = 1;
+  options.degree = 1;
+  CHECK(bireg::SplineRegression<R3>(options).fit(f, t).message ==
+        "roughness_penalty needs degree 2 or 3: it couples control points two apart");
+}
+
 // The same at the sizes where the fit works in pieces: 12,000 observations
 // (12 chunks of 1024), 1,203 control points (three pieces of 512 rows when
 // the chunks' sums are added, two pieces of control-point updates, and the
@@ -334,21 +398,24 @@ TEST_CASE("Spline fit is left and right equivariant", "[spline]") {
       left[i] = G::compose(g, data.f[i]);
       right[i] = G::compose(data.f[i], g);
     }
-    bireg::SplineOptions<double> options;
-    options.knot_spacing = 1.0;
-    options.tolerance = 1e-13;
-    const bireg::SplineRegression<G> regression(options);
-    const auto base = regression.fit(data.f, data.t), l = regression.fit(left, data.t),
-               r = regression.fit(right, data.t);
-    INFO(G::name);
-    REQUIRE(base.ok());
-    REQUIRE(l.ok());
-    REQUIRE(r.ok());
-    const auto& p = base.spline->control_points();
-    REQUIRE(p.size() == truth.control_points().size());
-    for (std::size_t c = 0; c < p.size(); ++c) {
-      CHECK(distance<G>(G::compose(g, p[c]), l.spline->control_points()[c]) < 1e-10);
-      CHECK(distance<G>(G::compose(p[c], g), r.spline->control_points()[c]) < 1e-10);
+    for (const double penalty : {0.0, 0.5}) {
+      bireg::SplineOptions<double> options;
+      options.knot_spacing = 1.0;
+      options.tolerance = 1e-13;
+      options.roughness_penalty = penalty;  // splines.md §12: no metric, still bi-invariant
+      const bireg::SplineRegression<G> regression(options);
+      const auto base = regression.fit(data.f, data.t), l = regression.fit(left, data.t),
+                 r = regression.fit(right, data.t);
+      INFO(G::name << " roughness penalty " << penalty);
+      REQUIRE(base.ok());
+      REQUIRE(l.ok());
+      REQUIRE(r.ok());
+      const auto& p = base.spline->control_points();
+      REQUIRE(p.size() == truth.control_points().size());
+      for (std::size_t c = 0; c < p.size(); ++c) {
+        CHECK(distance<G>(G::compose(g, p[c]), l.spline->control_points()[c]) < 1e-10);
+        CHECK(distance<G>(G::compose(p[c], g), r.spline->control_points()[c]) < 1e-10);
+      }
     }
   };
   check(SO3{});
@@ -610,6 +677,14 @@ TEST_CASE("Spline fit: control points swinging out beyond sparse noisy data are 
   // the noise, and its fit converges on the same data.
   options.degree = 2;
   CHECK(bireg::SplineRegression<SO3>(options).fit(data.f, data.t).ok());
+  // So does the cubic with a roughness penalty (splines.md §12), which
+  // ties the end increments to their neighbours where the data cannot.
+  options.degree = 3;
+  options.roughness_penalty = 1;
+  const auto penalised = bireg::SplineRegression<SO3>(options).fit(data.f, data.t);
+  INFO(penalised.message);
+  REQUIRE(penalised.ok());
+  CHECK_FALSE(penalised.beyond_domain);
 }
 
 // The Exp-stepped iteration P_c <- P_c exp(lambda F_c) of splines.md §7, run

@@ -241,6 +241,17 @@ TEST_CASE("Spline covariance refuses what it cannot estimate, saying why", "[spl
   CHECK(weighted.status == bireg::CovarianceStatus::invalid_input);
   CHECK(weighted.message.find("weight 7") != std::string::npos);
 
+  // A penalised fit (splines.md §12): its bands are not built, and say so.
+  bireg::SplineOptions<double> penalised_options;
+  penalised_options.knot_spacing = truth.knot_spacing();
+  penalised_options.interval = std::make_pair(truth.t_min(), truth.t_max());
+  penalised_options.roughness_penalty = 0.1;
+  const auto penalised_fit = bireg::SplineRegression<SO3>(penalised_options).fit(data.f, data.t);
+  REQUIRE(penalised_fit.ok());
+  const auto penalised = bireg::spline_covariance(penalised_fit, data.f, data.t);
+  CHECK(penalised.status == bireg::CovarianceStatus::undefined);
+  CHECK(penalised.message.find("roughness penalty") != std::string::npos);
+
   // Noise-free data: the noise covariance is zero.
   const Samples<SO3> exact = sample(truth, 40, 0.0, rng);
   const auto noise_free = bireg::spline_covariance(fit_on_knots(truth, exact), exact.f, exact.t);

@@ -74,6 +74,14 @@ struct SplineOptions {
   // K with every step. It changes the cost, not the answer beyond the
   // tolerance.
   Scalar jacobian_reuse_contraction = Scalar(0.01);
+  // lambda >= 0 of the roughness penalty (splines.md §12): F_c gains
+  // -lambda (s_{c-1} - 2 s_c + s_{c+1}), s_c = Omega_{c+1} - Omega_c, the
+  // second differences of the control points in increments, bi-invariant
+  // without a metric; in R^n the penalised normal equations (B^T W B +
+  // lambda D_2^T D_2) p = B^T W x, weights normalised to a largest of 1.
+  // 0: none. Degree 2 or 3 (the penalty couples control points two apart,
+  // beyond a piecewise geodesic's band).
+  Scalar roughness_penalty = 0;
   // The covariates mapped to the first and last knot, as for the geodesic
   // (RegressionOptions::interval); by default their smallest and largest.
   std::optional<std::pair<Wide, Wide>> interval;
@@ -101,6 +109,9 @@ struct SplineResult {
   // included: fewer than the steps where steps from an earlier K contract
   // well (splines.md §9, SplineOptions::jacobian_reuse_contraction).
   int jacobian_evaluations = 0;
+  // SplineOptions::roughness_penalty of the fit (0: none), for what reads
+  // the result later (spline_covariance refuses a penalised fit).
+  Scalar roughness_penalty = 0;
   std::vector<Tangent> residuals;  // r_i = log(T(t_i)^{-1} f_i), input order
   // max_c |F_c| at the returned control points (splines.md (6)), weights
   // normalised to a largest of 1.
@@ -294,6 +305,13 @@ class SplineRegression {
     if (options_.max_iterations < 1) return Rejection{"max_iterations must be at least 1"};
     if (!(options_.jacobian_reuse_contraction >= 0 && options_.jacobian_reuse_contraction < 1)) {
       return Rejection{"jacobian_reuse_contraction must be in [0, 1)"};
+    }
+    if (!(options_.roughness_penalty >= 0) || !isfinite(options_.roughness_penalty)) {
+      return Rejection{"roughness_penalty must be a finite non-negative number"};
+    }
+    if (options_.roughness_penalty > 0 && options_.degree < 2) {
+      return Rejection{
+          "roughness_penalty needs degree 2 or 3: it couples control points two apart"};
     }
     if (options_.threads < 1) {
       return Rejection{"threads must be at least 1, got " + std::to_string(options_.threads)};
@@ -533,9 +551,41 @@ class SplineRegression {
       }
     };
     run_ranges(scratch.pool, m, kReduceRows, reduce_rows);
+    if (options_.roughness_penalty > 0)
+      add_penalty(increment_jacobians, increments, jacobian, evaluation);
     for (const Tangent& f : evaluation.force)
       evaluation.merit += f.squaredNorm();
     evaluation.finite = std::isfinite(evaluation.merit);
+  }
+
+  // The roughness penalty (splines.md §12) into F and, with `jacobian`,
+  // its derivative into K: s_c = Omega_{c+1} - Omega_c for c = 1 .. M - 2
+  // (Omega_j = increments[j - 1]) enters F_a with the coefficient
+  // -lambda (1, -2, 1) for a = c - 1, c, c + 1; perturbing P_l -> P_l
+  // exp(delta_l) moves Omega_l by J_r(Omega_l)^{-1} delta_l and Omega_{l+1}
+  // by -J_l(Omega_{l+1})^{-1} delta_l, so ds_c/d delta is J_l(Omega_c)^{-1}
+  // at c - 1, -(J_l(Omega_{c+1})^{-1} + J_r(Omega_c)^{-1}) at c and
+  // J_r(Omega_{c+1})^{-1} at c + 1. Serial, after the chunks' sums: the
+  // same bits for any thread count.
+  void add_penalty(const std::vector<IncrementJacobians<G>>& increment_jacobians,
+                   const std::vector<Tangent>& increments,
+                   BlockBandedMatrix<AdMatrix, Tangent>* jacobian, Evaluation& evaluation) const {
+    const Scalar lambda = options_.roughness_penalty;
+    const std::size_t m = evaluation.force.size();
+    constexpr Scalar kCoefficient[3] = {1, -2, 1};
+    for (std::size_t c = 1; c + 1 < m; ++c) {
+      const Tangent s = increments[c] - increments[c - 1];
+      for (std::size_t a = 0; a < 3; ++a)
+        evaluation.force[c - 1 + a] -= (lambda * kCoefficient[a]) * s;
+      if (!jacobian) continue;
+      const IncrementJacobians<G>& before = increment_jacobians[c - 1];  // of Omega_c
+      const IncrementJacobians<G>& after = increment_jacobians[c];       // of Omega_{c+1}
+      const AdMatrix derivative[3] = {
+          before.left_inverse, -(after.left_inverse + before.right_inverse), after.right_inverse};
+      for (std::size_t a = 0; a < 3; ++a)
+        for (std::size_t l = 0; l < 3; ++l)
+          (*jacobian)(c - 1 + a, c - 1 + l).noalias() -= (lambda * kCoefficient[a]) * derivative[l];
+    }
   }
 
   // Why no step reduced |F|, from what the last iterate shows, in this
@@ -606,8 +656,8 @@ class SplineRegression {
                " rad: the control points swing out beyond the data, which determine them only "
                "weakly there (at 10 observations per span an end increment of a cubic spreads "
                "by about 14 times the noise per axis, of a quadratic by 3, of a piecewise "
-               "geodesic by 0.9); try a lower degree or more observations (wider knots barely "
-               "help)";
+               "geodesic by 0.9); try a lower degree, a roughness penalty or more "
+               "observations (wider knots barely help)";
       }
       return why + apart +
              ": the motion within a knot span is too large for the spline's control points; try "
@@ -754,6 +804,7 @@ typename SplineRegression<G>::Result SplineRegression<G>::run(
 
   // 3. Gauss-Newton with backtracking.
   Result result;
+  result.roughness_penalty = options_.roughness_penalty;
   result.residuals.resize(n);
   BlockBandedMatrix<AdMatrix, Tangent> jacobian(knots.control_points, std::size_t(options_.degree));
   Evaluation current(knots.control_points), next(knots.control_points);

@@ -120,7 +120,8 @@ typename G::AdMatrix segment_covariance(
 // covariates and weights). Refused (invalid_input) when the fit failed or
 // the data do not match it, undefined (with the reason) when no degrees of
 // freedom remain, the residuals vanish, K is singular, or the control
-// points have more than kSplineCovarianceMaxDimension coordinates.
+// points have more than kSplineCovarianceMaxDimension coordinates, or the
+// fit has a roughness penalty (not built).
 template <class G, class Observations, class Covariates>
 SplineCovariance<G> spline_covariance(const SplineResult<G>& fit, const Observations& observations,
                                       const Covariates& covariates,
@@ -136,6 +137,12 @@ SplineCovariance<G> spline_covariance(const SplineResult<G>& fit, const Observat
     return refused<G>(CovarianceStatus::invalid_input, "the fit did not succeed (" +
                                                            std::string(to_string(fit.status)) +
                                                            "): its covariance is undefined");
+  }
+  if (fit.roughness_penalty > 0) {
+    return refused<G>(CovarianceStatus::undefined,
+                      "the covariance of a spline fitted with a roughness penalty is not "
+                      "computed: the sandwich would need the penalty's bias and its share of K "
+                      "(docs/splines.md §12)");
   }
   const Spline<G>& spline = *fit.spline;
   const std::size_t n = observations.size();
