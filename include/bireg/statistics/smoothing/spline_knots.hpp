@@ -28,9 +28,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,17 +81,145 @@ std::vector<Scalar> auto_knot_spacing_grid(std::vector<Scalar> covariates) {
   return grid;
 }
 
-// Cross-validates the grid (ascending, positive) with `folds` folds (at
-// least 2). `options` gives everything but the spacing and the interval.
+namespace detail {
+
+// What both selections below share: the folds (the r-th observation in
+// covariate order in fold r mod F), the interval of the data's range, and
+// the cross-validated criterion of one SplineOptions.
+template <class Scalar>
+struct SplineFolds {
+  std::vector<std::size_t> fold_of;
+  std::pair<CovariateScalar<Scalar>, CovariateScalar<Scalar>> interval;
+  std::size_t folds = 0;
+};
+
+template <class Scalar, class Covariates>
+SplineFolds<Scalar> deal_spline_folds(const Covariates& covariates, std::size_t folds) {
+  const std::size_t n = covariates.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return covariates[a] < covariates[b]; });
+  SplineFolds<Scalar> dealt;
+  dealt.folds = folds;
+  dealt.fold_of.resize(n);
+  for (std::size_t r = 0; r < n; ++r)
+    dealt.fold_of[order[r]] = r % folds;
+  dealt.interval = std::make_pair(CovariateScalar<Scalar>(covariates[order.front()]),
+                                  CovariateScalar<Scalar>(covariates[order.back()]));
+  return dealt;
+}
+
+template <class Scalar>
+struct SplineScore {
+  Scalar criterion = std::numeric_limits<Scalar>::infinity();
+  std::size_t failures = 0;
+  std::string refusal;   // empty: the criterion stands
+  bool full_ok = false;  // the fit to all observations succeeded
+};
+
+// The fit to all observations, then each fold held out in turn and fitted
+// from it; det(S)^(1/d) of the held-out prediction errors, or the first
+// failure's message. `after_fit` (if set) is called after each of the
+// 1 + folds fits, tried or not.
 template <class G, class Observations, class Covariates>
-KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
-    const Observations& observations, const Covariates& covariates,
-    const SplineOptions<typename G::Scalar>& options, const std::vector<typename G::Scalar>& grid,
-    std::size_t folds = 5) {
+SplineScore<typename G::Scalar> spline_cross_validation_score(
+    const SplineRegression<G>& regression, const Observations& observations,
+    const Covariates& covariates, const SplineFolds<typename G::Scalar>& dealt,
+    const std::function<void()>& after_fit) {
   using Scalar = typename G::Scalar;
   using Element = typename G::Element;
   using Tangent = typename G::Tangent;
   using Covariance = Eigen::Matrix<Scalar, G::dof, G::dof>;
+  const std::size_t n = observations.size();
+  SplineScore<Scalar> score;
+  const auto full = regression.fit(observations, covariates);
+  if (after_fit) after_fit();
+  score.full_ok = full.ok();
+  if (!full.ok()) {
+    for (std::size_t fold = 0; fold < dealt.folds && after_fit; ++fold)
+      after_fit();
+    score.failures = 1;
+    score.refusal = std::string("the fit to all observations: ") +
+                    (full.message.empty() ? to_string(full.status) : full.message);
+    return score;
+  }
+  std::vector<Element> train_f;
+  std::vector<Scalar> train_t;
+  Covariance scatter = Covariance::Zero();
+  for (std::size_t fold = 0; fold < dealt.folds; ++fold) {
+    train_f.clear();
+    train_t.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (dealt.fold_of[i] == fold) continue;
+      train_f.push_back(observations[i]);
+      train_t.push_back(covariates[i]);
+    }
+    const auto fit = regression.fit_from(full.spline->control_points(), train_f, train_t);
+    if (after_fit) after_fit();
+    if (!fit.ok()) {
+      ++score.failures;
+      if (score.refusal.empty()) {
+        score.refusal = "fold " + std::to_string(fold) + ": " +
+                        (fit.message.empty() ? to_string(fit.status) : fit.message);
+      }
+      continue;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (dealt.fold_of[i] != fold) continue;
+      const Tangent e =
+          G::log(G::compose(G::inverse((*fit.spline)(Scalar(covariates[i]))), observations[i]));
+      scatter.noalias() += e * e.transpose();
+    }
+  }
+  if (!score.refusal.empty()) return score;
+  using std::pow;
+  const Scalar determinant = (scatter / Scalar(n)).determinant();
+  if (determinant > 0 && std::isfinite(determinant)) {
+    score.criterion = pow(determinant, Scalar(1) / Scalar(G::dof));
+  } else {
+    score.refusal = "the prediction errors' covariance is singular or not finite";
+  }
+  return score;
+}
+
+// The index of the smallest criterion among the values not refused, or
+// refusals.size() when every value was refused.
+template <class Scalar>
+std::size_t smallest_unrefused(const std::vector<Scalar>& criterion,
+                               const std::vector<std::string>& refusals) {
+  std::size_t best = refusals.size();
+  for (std::size_t v = 0; v < refusals.size(); ++v) {
+    if (!refusals[v].empty()) continue;
+    if (best == refusals.size() || criterion[v] < criterion[best]) best = v;
+  }
+  return best;
+}
+
+// Empty when the grid is positive and ascending, else what is wrong.
+template <class Scalar>
+std::string grid_problem(const std::vector<Scalar>& grid, const char* what) {
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    if (!(grid[v] > 0) || !std::isfinite(grid[v]) || (v > 0 && !(grid[v] > grid[v - 1]))) {
+      return std::string("the ") + what + " grid must be positive, finite and ascending (value " +
+             std::to_string(v) + ")";
+    }
+  }
+  return {};
+}
+
+}  // namespace detail
+
+// Cross-validates the grid (ascending, positive) with `folds` folds (at
+// least 2). `options` gives everything but the spacing and the interval.
+// `progress`, when set, is called with (fits done, fits in all) after each
+// of the grid's (1 + folds) fits per value, values not tried counted done.
+template <class G, class Observations, class Covariates>
+KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
+    const Observations& observations, const Covariates& covariates,
+    const SplineOptions<typename G::Scalar>& options, const std::vector<typename G::Scalar>& grid,
+    std::size_t folds = 5, const std::function<void(std::size_t, std::size_t)>& progress = {}) {
+  using Scalar = typename G::Scalar;
   KnotSpacingSelection<Scalar> selection;
   selection.grid = grid;
   // Nothing can be tried: every grid value refused for the one reason, so
@@ -107,29 +237,20 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
         "knot spacing selection needs a grid, at least 2 folds and at least 2 "
         "observations per fold");
   }
-  for (std::size_t v = 0; v < grid.size(); ++v) {
-    if (!(grid[v] > 0) || (v > 0 && !(grid[v] > grid[v - 1]))) {
-      return refuse_all("the knot spacing grid must be positive and ascending (value " +
-                        std::to_string(v) + ")");
-    }
-  }
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return covariates[a] < covariates[b]; });
-  std::vector<std::size_t> fold_of(n);
-  for (std::size_t r = 0; r < n; ++r)
-    fold_of[order[r]] = r % folds;
+  const std::string bad_grid = detail::grid_problem(grid, "knot spacing");
+  if (!bad_grid.empty()) return refuse_all(bad_grid);
+  const auto dealt = detail::deal_spline_folds<Scalar>(covariates, folds);
   SplineOptions<Scalar> fixed = options;
-  fixed.interval = std::make_pair(CovariateScalar<Scalar>(covariates[order.front()]),
-                                  CovariateScalar<Scalar>(covariates[order.back()]));
+  fixed.interval = dealt.interval;
 
-  std::vector<Element> train_f;
-  std::vector<Scalar> train_t;
   bool fitted = false;          // a narrower spacing's fit to all observations succeeded
   Scalar failed_after_fit = 0;  // the first spacing whose fit failed after one succeeded
+  const std::size_t fits = grid.size() * (1 + folds);
+  std::size_t fits_done = 0;
+  const std::function<void()> after_fit = [&] { progress(++fits_done, fits); };
   for (const Scalar spacing : grid) {
     if (failed_after_fit > 0) {
+      fits_done += 1 + folds;
       selection.criterion.push_back(std::numeric_limits<Scalar>::infinity());
       selection.failures.push_back(0);
       selection.refusals.push_back(
@@ -138,61 +259,17 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
       continue;
     }
     fixed.knot_spacing = spacing;
-    const SplineRegression<G> regression(fixed);
-    std::size_t failures = 0;
-    std::string refusal;
-    const auto full = regression.fit(observations, covariates);
-    if (full.ok()) fitted = true;
-    if (!full.ok() && fitted) failed_after_fit = spacing;
-    if (!full.ok()) {
-      failures = 1;
-      refusal = std::string("the fit to all observations: ") +
-                (full.message.empty() ? to_string(full.status) : full.message);
-    }
-    Covariance scatter = Covariance::Zero();
-    for (std::size_t fold = 0; fold < folds && full.ok(); ++fold) {
-      train_f.clear();
-      train_t.clear();
-      for (std::size_t i = 0; i < n; ++i) {
-        if (fold_of[i] == fold) continue;
-        train_f.push_back(observations[i]);
-        train_t.push_back(covariates[i]);
-      }
-      const auto fit = regression.fit_from(full.spline->control_points(), train_f, train_t);
-      if (!fit.ok()) {
-        ++failures;
-        if (refusal.empty()) {
-          refusal = "fold " + std::to_string(fold) + ": " +
-                    (fit.message.empty() ? to_string(fit.status) : fit.message);
-        }
-        continue;
-      }
-      for (std::size_t i = 0; i < n; ++i) {
-        if (fold_of[i] != fold) continue;
-        const Tangent e =
-            G::log(G::compose(G::inverse((*fit.spline)(Scalar(covariates[i]))), observations[i]));
-        scatter.noalias() += e * e.transpose();
-      }
-    }
-    Scalar criterion = std::numeric_limits<Scalar>::infinity();
-    if (refusal.empty()) {
-      using std::pow;
-      const Scalar determinant = (scatter / Scalar(n)).determinant();
-      if (determinant > 0 && std::isfinite(determinant)) {
-        criterion = pow(determinant, Scalar(1) / Scalar(G::dof));
-      } else {
-        refusal = "the prediction errors' covariance is singular or not finite";
-      }
-    }
-    selection.criterion.push_back(criterion);
-    selection.failures.push_back(failures);
-    selection.refusals.push_back(refusal);
+    const auto score = detail::spline_cross_validation_score(
+        SplineRegression<G>(fixed), observations, covariates, dealt,
+        progress ? after_fit : std::function<void()>());
+    if (score.full_ok) fitted = true;
+    if (!score.full_ok && fitted) failed_after_fit = spacing;
+    selection.criterion.push_back(score.criterion);
+    selection.failures.push_back(score.failures);
+    selection.refusals.push_back(score.refusal);
   }
-  std::size_t best = grid.size();
-  for (std::size_t v = 0; v < grid.size(); ++v) {
-    if (!selection.refusals[v].empty()) continue;
-    if (best == grid.size() || selection.criterion[v] < selection.criterion[best]) best = v;
-  }
+  if (progress) progress(fits, fits);
+  const std::size_t best = detail::smallest_unrefused(selection.criterion, selection.refusals);
   if (best == grid.size()) {
     selection.message = "every knot spacing was refused; the first: " + selection.refusals[0];
     return selection;

@@ -1,0 +1,177 @@
+// bireg: the roughness penalty of a spline regression
+// (SplineOptions::roughness_penalty, docs/splines.md §12) by
+// cross-validation, with the folds and the invariant criterion of the knot
+// spacing's selection (statistics/smoothing/spline_knots.hpp).
+//
+// The knots stay where the caller put them (fine, about one per sample or
+// two); lambda trades the fit to the data against the second differences
+// of the increments. Every lambda on the grid is scored as a knot spacing
+// is: the fit to all observations, then each fold held out and fitted from
+// it, det(S)^(1/d) of the held-out prediction errors. Lambda scales F's
+// penalty term against its data term, whose size is the weight of the
+// observations near a control point, so the automatic grid is in units of
+// the observations per knot span. Left and right invariant as the knot
+// spacing's choice is: the penalty and the residuals move by the same Ad.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "bireg/statistics/smoothing/spline_knots.hpp"
+
+namespace bireg {
+
+template <class Scalar>
+struct RoughnessPenaltySelection {
+  Scalar roughness_penalty = 0;  // the choice (0: none)
+  std::vector<Scalar> grid;      // ascending
+  // det(S)^(1/d) per grid value; infinite where refused.
+  std::vector<Scalar> criterion;
+  // Per grid value: the fits that failed (the full fit counts as one) and
+  // why the value was refused (empty: it was not).
+  std::vector<std::size_t> failures;
+  std::vector<std::string> refusals;
+  // The choice is the grid's first or last value: the best may lie beyond.
+  bool at_edge = false;
+  // What a user should be told; empty when there is nothing to say.
+  std::string message;
+  bool ok() const { return roughness_penalty > 0; }
+};
+
+// Geometric, four values a decade, in units of w = N min(h, range) /
+// range, the observations per knot span. In R^n the penalised fit is a
+// kernel smoother whose window is about (lambda / w)^(1/4) knot spans (the
+// second-difference P-spline's), so the grid runs from 1e-4 w (a tenth of
+// a span: the penalty barely felt) to w W^4 with W = min(S, 100) the
+// widest window, S the number of spans: a window of the whole range or of
+// a hundred spans, whichever is shorter. Empty when the covariates have no
+// range or the spacing is not positive.
+constexpr int kRoughnessValuesPerDecade = 4;
+
+template <class Scalar>
+std::vector<Scalar> auto_roughness_penalty_grid(const std::vector<Scalar>& covariates,
+                                                Scalar knot_spacing) {
+  using std::ceil;
+  using std::log10;
+  using std::pow;
+  std::vector<Scalar> grid;
+  if (covariates.size() < 2 || !(knot_spacing > 0)) return grid;
+  const auto [lowest, highest] = std::minmax_element(covariates.begin(), covariates.end());
+  const Scalar range = *highest - *lowest;
+  if (!(range > 0) || !std::isfinite(range)) return grid;
+  const Scalar per_span = Scalar(covariates.size()) * std::min(knot_spacing, range) / range;
+  const Scalar widest = std::min(ceil(range / knot_spacing), Scalar(100));
+  const Scalar low = Scalar(-4);
+  const Scalar high = Scalar(4) * log10(widest);
+  const int values = 1 + static_cast<int>(ceil(Scalar(kRoughnessValuesPerDecade) * (high - low)));
+  for (int v = 0; v < values; ++v)
+    grid.push_back(per_span * pow(Scalar(10), low + (high - low) * Scalar(v) / Scalar(values - 1)));
+  return grid;
+}
+
+// The knots of a penalised spline when none are given: 1.5 median
+// covariate spacings, as fine as the fits of the folds allow (each holds
+// 4/5 of the observations: 5 knot spans for every 6 of them) and as coarse
+// as the x-IMU recording's velocity allowed without loss (docs/splines.md
+// §12); lambda then does the smoothing. 0 when the covariates have no
+// spacing.
+template <class Scalar>
+Scalar fine_knot_spacing(std::vector<Scalar> covariates) {
+  std::sort(covariates.begin(), covariates.end());
+  std::vector<Scalar> gaps;
+  for (std::size_t i = 1; i < covariates.size(); ++i) {
+    if (covariates[i] > covariates[i - 1]) gaps.push_back(covariates[i] - covariates[i - 1]);
+  }
+  if (gaps.empty()) return Scalar(0);
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  return Scalar(1.5) * gaps[gaps.size() / 2];
+}
+
+// Cross-validates the grid of lambdas (ascending, positive) with `folds`
+// folds (at least 2). `options` gives everything but lambda and the
+// interval: a finite knot spacing and degree 2 or 3. Once the criterion
+// has not gone below its smallest for 2 decades of lambda (the grid's
+// values past it up to 100 times it), the larger values are not tried
+// (refused as "not tried"): each costs 1 + folds fits, and a wider grid
+// mostly lies on the side where the curve flattens towards a geodesic.
+// `progress` as for select_knot_spacing.
+template <class G, class Observations, class Covariates>
+RoughnessPenaltySelection<typename G::Scalar> select_roughness_penalty(
+    const Observations& observations, const Covariates& covariates,
+    const SplineOptions<typename G::Scalar>& options, const std::vector<typename G::Scalar>& grid,
+    std::size_t folds = 5, const std::function<void(std::size_t, std::size_t)>& progress = {}) {
+  using Scalar = typename G::Scalar;
+  RoughnessPenaltySelection<Scalar> selection;
+  selection.grid = grid;
+  const auto refuse_all = [&](const std::string& message) {
+    selection.message = message;
+    selection.criterion.assign(grid.size(), std::numeric_limits<Scalar>::infinity());
+    selection.failures.assign(grid.size(), 0);
+    selection.refusals.assign(grid.size(), "not tried: " + message);
+    return selection;
+  };
+  const std::size_t n = observations.size();
+  if (grid.empty() || folds < 2 || covariates.size() != n || n < 2 * folds) {
+    return refuse_all(
+        "roughness penalty selection needs a grid, at least 2 folds and at least 2 "
+        "observations per fold");
+  }
+  if (options.degree < 2 || options.degree > 3) {
+    return refuse_all(
+        "roughness penalty selection needs degree 2 or 3 (the penalty couples "
+        "control points two apart)");
+  }
+  if (!(options.knot_spacing > 0) || !std::isfinite(double(options.knot_spacing))) {
+    return refuse_all("roughness penalty selection needs a finite positive knot spacing");
+  }
+  const std::string bad_grid = detail::grid_problem(grid, "roughness penalty");
+  if (!bad_grid.empty()) return refuse_all(bad_grid);
+  const auto dealt = detail::deal_spline_folds<Scalar>(covariates, folds);
+  SplineOptions<Scalar> fixed = options;
+  fixed.interval = dealt.interval;
+  const std::size_t fits = grid.size() * (1 + folds);
+  std::size_t fits_done = 0;
+  const std::function<void()> after_fit = [&] { progress(++fits_done, fits); };
+  std::size_t best = grid.size();
+  for (std::size_t v = 0; v < grid.size(); ++v) {
+    const Scalar lambda = grid[v];
+    if (best < grid.size() && lambda > Scalar(100) * grid[best]) {
+      fits_done += 1 + folds;
+      selection.criterion.push_back(std::numeric_limits<Scalar>::infinity());
+      selection.failures.push_back(0);
+      selection.refusals.push_back("not tried: the criterion stayed above its value at lambda " +
+                                   std::to_string(double(grid[best])) + " for two decades past it");
+      continue;
+    }
+    fixed.roughness_penalty = lambda;
+    const auto score = detail::spline_cross_validation_score(
+        SplineRegression<G>(fixed), observations, covariates, dealt,
+        progress ? after_fit : std::function<void()>());
+    selection.criterion.push_back(score.criterion);
+    selection.failures.push_back(score.failures);
+    selection.refusals.push_back(score.refusal);
+    if (score.refusal.empty() &&
+        (best == grid.size() || score.criterion < selection.criterion[best]))
+      best = v;
+  }
+  if (progress) progress(fits, fits);
+  if (best == grid.size()) {
+    selection.message = "every roughness penalty was refused; the first: " + selection.refusals[0];
+    return selection;
+  }
+  selection.roughness_penalty = grid[best];
+  selection.at_edge = best == 0 || best + 1 == grid.size();
+  if (selection.at_edge) {
+    selection.message = std::string("the chosen roughness penalty is the grid's ") +
+                        (best == 0 ? "smallest" : "largest") +
+                        " value: the best may lie beyond the grid";
+  }
+  return selection;
+}
+
+}  // namespace bireg
