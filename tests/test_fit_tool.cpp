@@ -33,6 +33,7 @@
 #include "bireg/statistics/inference/mean.hpp"
 #include "bireg/statistics/inference/trend_test.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
+#include "bireg/statistics/smoothing/spline_roughness.hpp"
 #include "bireg/version.hpp"
 #include "catch.hpp"
 #include "test_support.hpp"
@@ -248,16 +249,19 @@ TEST_CASE("bireg_fit --help lists every option with its default, and the exit co
     REQUIRE(run.out.rfind("usage: bireg_fit", 0) == 0);
     // Every option the tool takes, on one line of its own that says what it
     // does and its default (or that it is required).
-    const std::vector<std::string> options = {
-        "--group",         "--format",       "--times",
-        "--project",       "--method",       "--order",
-        "--solver",        "--step",         "--tol",
-        "--max-iter",      "--loss",         "--loss-scale",
-        "--confidence",    "--permutations", "--seed",
-        "--output-band",   "--model",        "--degree",
-        "--knot-spacing",  "--cv-table",     "--output-trajectory",
-        "--output-format", "--threads",      "--help",
-        "--version"};
+    const std::vector<std::string> options = {"--group",         "--format",
+                                              "--times",         "--project",
+                                              "--method",        "--order",
+                                              "--solver",        "--step",
+                                              "--tol",           "--max-iter",
+                                              "--loss",          "--loss-scale",
+                                              "--confidence",    "--permutations",
+                                              "--seed",          "--output-band",
+                                              "--model",         "--degree",
+                                              "--knot-spacing",  "--roughness-penalty",
+                                              "--cv-table",      "--output-trajectory",
+                                              "--output-format", "--threads",
+                                              "--help",          "--version"};
     std::map<std::string, std::string> line_of;
     std::istringstream lines(run.out);
     for (std::string line; std::getline(lines, line);) {
@@ -433,6 +437,39 @@ TEST_CASE("bireg_fit --model spline prints the library's spline: control points 
   REQUIRE(json_numbers(automatic.out, "chosen").at(0) == selection.knot_spacing);
   REQUIRE(automatic.out.find("\"candidates\": [") != std::string::npos);
   REQUIRE_FALSE(json_has_non_finite(automatic.out));
+  REQUIRE(json_numbers(automatic.out, "roughness_penalty").at(0) == 0);
+  REQUIRE(json_string(automatic.out, "roughness_penalty_source") == "given");
+
+  // --roughness-penalty auto: fine knots, lambda by the library's
+  // cross-validation, the fit the library's with both.
+  const Run penalised =
+      run_tool("--group SE3 --model spline --roughness-penalty auto \"" + input.string() + "\"");
+  CAPTURE(penalised.err);
+  REQUIRE(penalised.exit_code == 0);
+  REQUIRE(json_string(penalised.out, "knot_spacing_source") == "fine");
+  REQUIRE(json_string(penalised.out, "roughness_penalty_source") == "auto");
+  REQUIRE(penalised.out.find("\"roughness_selection\": {\"chosen\": ") != std::string::npos);
+  REQUIRE(penalised.out.find("\"knot_selection\"") == std::string::npos);
+  REQUIRE_FALSE(json_has_non_finite(penalised.out));
+  bireg::SplineOptions<double> fine;
+  fine.knot_spacing = bireg::fine_knot_spacing(trajectory.covariates);
+  const auto roughness = bireg::select_roughness_penalty<G>(
+      trajectory.observations, trajectory.covariates, fine,
+      bireg::auto_roughness_penalty_grid(trajectory.covariates, double(fine.knot_spacing)));
+  REQUIRE(roughness.ok());
+  REQUIRE(json_numbers(penalised.out, "roughness_penalty").at(0) == roughness.roughness_penalty);
+  fine.roughness_penalty = roughness.roughness_penalty;
+  const auto smooth =
+      bireg::SplineRegression<G>(fine).fit(trajectory.observations, trajectory.covariates);
+  REQUIRE(smooth.ok());
+  const std::vector<double> smooth_points = json_numbers(penalised.out, "control_points");
+  REQUIRE(smooth_points.size() == 16 * smooth.spline->control_points().size());
+  for (std::size_t j = 0; j < smooth.spline->control_points().size(); ++j) {
+    const std::vector<double> entries(smooth_points.begin() + 16 * j,
+                                      smooth_points.begin() + 16 * (j + 1));
+    REQUIRE(bireg_test::relative_error(element_of<G>(entries),
+                                       smooth.spline->control_points()[j]) <= 1e-12);
+  }
 
   // Each model's options are refused with the other, and the groups without
   // a spline are named.
@@ -443,13 +480,20 @@ TEST_CASE("bireg_fit --model spline prints the library's spline: control points 
        "--confidence applies to --model geodesic only"},
       {"--group SE3 --degree 2", "--degree applies to --model spline only"},
       {"--group SE3 --knot-spacing 1", "--knot-spacing applies to --model spline only"},
+      {"--group SE3 --roughness-penalty 1", "--roughness-penalty applies to --model spline only"},
+      {"--group SE3 --model spline --roughness-penalty -2",
+       "--roughness-penalty needs a number >= 0 or auto, got '-2'"},
+      {"--group SE3 --model spline --degree 1 --roughness-penalty auto",
+       "--roughness-penalty needs --degree 2 or 3"},
+      {"--group SE3 --model spline --degree 1 --roughness-penalty 0.5",
+       "--roughness-penalty needs --degree 2 or 3"},
       {"--group SE3 --model spline --knot-spacing 0", "--knot-spacing needs a positive number"},
       {"--group SE3 --model spline --degree 4", "--degree needs 1, 2 or 3"},
       {"--group SE3 --model cubic", "unknown model 'cubic' (geodesic or spline)"},
       {"--group SE3 --model spline --method series", "--method applies to --model geodesic only"},
       {"--group SE3 --model spline --seed 1", "--seed applies to --model geodesic only"},
       {"--group SE3 --model spline --knot-spacing 1 --cv-table t.csv",
-       "--cv-table goes with --knot-spacing auto"},
+       "--cv-table goes with --knot-spacing auto or --roughness-penalty auto"},
       {"--group Sim3 --model spline", "--model spline fits SO2, SO3, SE2 and SE3, not Sim3"},
       {"--group Foo --model spline", "unknown group 'Foo' (--model spline fits SO2, SO3, SE2 or"},
       {"--group auto --model spline", "--group auto chooses among geodesic motion models"}};

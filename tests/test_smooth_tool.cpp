@@ -118,14 +118,23 @@ struct GeodesicFile {
   }
 };
 
+// With noise > 0, each sample is the geodesic's times exp of N(0, noise^2)
+// coordinates drawn from `rng` (at() stays the truth).
 template <class G>
 GeodesicFile<G> geodesic_file(const typename G::Tangent& start, const typename G::Tangent& velocity,
-                              int n) {
+                              int n, double noise = 0, std::mt19937* rng = nullptr) {
   GeodesicFile<G> file;
   file.g0 = G::exp(start);
   file.velocity = velocity;
+  std::normal_distribution<double> normal(0.0, noise);
   for (int k = 0; k < n; ++k) {
-    const typename G::Element g = file.at(k / 10.0);
+    typename G::Element g = file.at(k / 10.0);
+    if (noise > 0) {
+      typename G::Tangent e;
+      for (int i = 0; i < G::dof; ++i)
+        e[i] = normal(*rng);
+      g = g * G::exp(e);
+    }
     file.text += std::to_string(100 + k / 10) + "." + std::to_string(k % 10);
     for (int r = 0; r < g.rows(); ++r) {
       for (int c = 0; c < g.cols(); ++c)
@@ -216,6 +225,12 @@ TEST_CASE("bireg_smooth: bad usage gives exit 2 with the message and the usage",
       {"--group SO3 --method spline --degree 4" + small, "--degree needs 1, 2 or 3"},
       {"--group SO3 --method spline --knot-spacing -1" + small,
        "--knot-spacing needs a positive number or auto"},
+      {"--group SO3 --roughness-penalty 1" + small,
+       "--roughness-penalty applies to --method spline only"},
+      {"--group SO3 --method spline --roughness-penalty -1" + small,
+       "--roughness-penalty needs a number >= 0 or auto, got '-1'"},
+      {"--group SO3 --method spline --roughness-penalty smooth" + small,
+       "--roughness-penalty needs a number >= 0 or auto, got 'smooth'"},
   };
   for (const auto& [args, expected] : cases) {
     CAPTURE(args);
@@ -320,18 +335,8 @@ TEST_CASE("bireg_smooth --method spline: a noise-free SO3 geodesic, its velocity
   // end control point is pinned only by the few observations near it
   // (B_0 = (1 - u)^3 / 6).
   std::mt19937 rng(8);
-  std::normal_distribution<double> normal(0.0, 0.01);
-  std::string noisy;
-  for (int k = 0; k < 60; ++k) {
-    const G::Element g =
-        file.at(k / 10.0) * G::exp(G::Tangent(normal(rng), normal(rng), normal(rng)));
-    noisy += std::to_string(100 + k / 10) + "." + std::to_string(k % 10);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c)
-        noisy += ", " + number_text(g(r, c));
-    }
-    noisy += '\n';
-  }
+  const std::string noisy =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.8, -0.4, 1.1), 60, 0.01, &rng).text;
   const fs::path noisy_velocity = work_dir() / "so3_spline_noisy_velocity.csv";
   const Run banded =
       run_tool("--group SO3 --method spline --knot-spacing 0.5 --velocity \"" +
@@ -384,6 +389,64 @@ TEST_CASE("bireg_smooth --method spline: a noise-free SO3 geodesic, its velocity
   REQUIRE(dense.exit_code == 2);
   REQUIRE(dense.err.find("control points for 60 observations; use a wider spacing") !=
           std::string::npos);
+}
+
+// --roughness-penalty auto on noisy samples of a geodesic: a geodesic is
+// in the penalty's null space (docs/splines.md §12), so cross-validation
+// chooses a strong penalty (at least 10 observations per span, a window of
+// about 1.8 spans; beyond some lambda the criterion is flat up to its
+// noise); the velocity is then about the least-squares geodesic's, whose
+// standard error here is 0.01 sqrt(12 / (60 x 5.9^2)) = 7.6e-4 rad/s per
+// axis: 5e-3 is more than 6 of them. Fine knots: 1.5 sample spacings.
+TEST_CASE("bireg_smooth --method spline --roughness-penalty: chosen, said, tabled, refused",
+          "[tool]") {
+  using G = bireg::SO3<double>;
+  std::mt19937 rng(9);
+  const GeodesicFile<G> file =
+      geodesic_file<G>(G::Tangent(0.3, -1.2, 0.5), G::Tangent(0.8, -0.4, 1.1), 60, 0.01, &rng);
+  const std::string input = make_file("so3_spline_penalised.csv", file.text);
+  const fs::path velocity = work_dir() / "so3_spline_penalised_velocity.csv";
+  const fs::path table = work_dir() / "so3_spline_penalised_cv.csv";
+  const Run run = run_tool("--group SO3 --method spline --roughness-penalty auto --velocity \"" +
+                           velocity.string() + "\" --cv-table \"" + table.string() + "\" " + input);
+  CAPTURE(run.err);
+  REQUIRE(run.exit_code == 0);
+  REQUIRE(run.err.find("bireg_smooth: knot spacing auto with --roughness-penalty auto: 0.1") == 0);
+  REQUIRE(run.err.find(" s (1.5 median sample spacings)\n") != std::string::npos);
+  const std::string said = "\nbireg_smooth: roughness penalty auto: ";
+  const std::size_t at = run.err.find(said);
+  REQUIRE(at != std::string::npos);
+  REQUIRE(std::strtod(run.err.c_str() + at + said.size(), nullptr) >= 10 * 1.5);
+  REQUIRE(run.err.find("no velocity standard errors: the covariance of a spline fitted with a "
+                       "roughness penalty") != std::string::npos);
+  const std::vector<std::string> curve = split(slurp(table), '\n');
+  REQUIRE(curve.at(0) == "roughness_penalty,criterion,failures,refused");
+  const std::string text = slurp(velocity);
+  const std::vector<Line> rows = parse_csv(text.substr(split(text, '\n').at(0).size() + 1));
+  REQUIRE(rows.size() == 60);
+  for (const Line& row : rows) {
+    CAPTURE(row.time);
+    REQUIRE(row.status == "ok");
+    for (std::size_t i = 0; i < 3; ++i) {
+      REQUIRE(std::abs(row.numbers[i] - file.velocity[int(i)]) < 5e-3);
+      REQUIRE(std::isnan(row.numbers[3 + i]));  // no standard errors
+    }
+  }
+
+  // A lambda given: no cross-validation; degree 1 with one: refused.
+  const Run given =
+      run_tool("--group SO3 --method spline --knot-spacing 0.5 --roughness-penalty 2 " + input);
+  CAPTURE(given.err);
+  REQUIRE(given.exit_code == 0);
+  REQUIRE(given.err.find("auto") == std::string::npos);
+  const Run linear = run_tool(
+      "--group SO3 --method spline --degree 1 --knot-spacing 0.5 --roughness-penalty 2 " + input);
+  REQUIRE(linear.exit_code == 2);
+  REQUIRE(linear.err.find("bireg_smooth: --roughness-penalty needs --degree 2 or 3") == 0);
+  const Run linear_auto =
+      run_tool("--group SO3 --method spline --degree 1 --roughness-penalty auto " + input);
+  REQUIRE(linear_auto.exit_code == 2);
+  REQUIRE(linear_auto.err.find("bireg_smooth: --roughness-penalty needs --degree 2 or 3") == 0);
 }
 
 TEST_CASE("bireg_smooth: SE3 velocity columns are translation first, as the group's tangent",

@@ -10,7 +10,8 @@
 //             [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]
 //             [--threads N] FILE|-
 //   bireg_fit --group SO2|SO3|SE2|SE3 --model spline [--degree 1|2|3]
-//             [--knot-spacing S|auto] [--cv-table FILE] [input and output options]
+//             [--knot-spacing S|auto] [--roughness-penalty LAMBDA|auto]
+//             [--cv-table FILE] [input and output options]
 //             [--tol X] [--max-iter K] [--threads N] FILE|-
 //   bireg_fit --help | --version
 //
@@ -22,7 +23,13 @@
 // writes that curve). The JSON then holds the curve: "degree",
 // "knot_spacing", "knots" (covariates after t_min), "control_points" (one
 // matrix each), the status and diagnostics and, for auto, a
-// "knot_selection" object with every spacing tried. --output-trajectory
+// "knot_selection" object with every spacing tried. --roughness-penalty
+// LAMBDA|auto (default 0: none; degree 2 or 3) adds the second-difference
+// penalty of SplineOptions::roughness_penalty; auto chooses lambda by
+// cross-validation at the knot spacing given, or at 1.5 median sample
+// spacings with --knot-spacing auto, and adds "roughness_selection";
+// "roughness_penalty" and its "roughness_penalty_source" are always
+// there. --output-trajectory
 // writes the spline at every input time. The geodesic's solver, series,
 // robust and statistics options are refused with it.
 //
@@ -122,8 +129,8 @@ constexpr const char* kUsage =
     "                 [--output-trajectory FILE [--output-format matrix|tum|euroc|kitti]]\n"
     "                 [--threads N] FILE|-\n"
     "       bireg_fit --group SO2|SO3|SE2|SE3 --model spline [--degree 1|2|3]\n"
-    "                 [--knot-spacing S|auto] [--cv-table FILE] [--tol X] [--max-iter K] ... "
-    "FILE|-\n"
+    "                 [--knot-spacing S|auto] [--roughness-penalty LAMBDA|auto]\n"
+    "                 [--cv-table FILE] [--tol X] [--max-iter K] ... FILE|-\n"
     "       bireg_fit --help | --version\n";
 
 // --help: the usage, every option on one line with its meaning and default
@@ -181,7 +188,10 @@ std::string help_text() {
       "  --degree K                the spline's degree, 1, 2 or 3 (default 3)\n"
       "  --knot-spacing S|auto     the spline's largest knot spacing in seconds, or auto: "
       "cross-validated (default auto)\n"
-      "  --cv-table FILE           CSV of the knot spacings tried by auto (default none)\n"
+      "  --roughness-penalty L|auto  the spline's second-difference penalty, >= 0, degree 2 "
+      "or 3; auto: cross-validated at fine knots (default 0: none)\n"
+      "  --cv-table FILE           CSV of the knot spacings (or penalties) tried by auto "
+      "(default none)\n"
       "  --output-trajectory FILE  write the fitted curve at every input time (default none)\n"
       "  --output-format F         the format of --output-trajectory (default the input's)\n"
       "  --threads N               threads; the output does not depend on N (default every core: " +
@@ -335,13 +345,10 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
       if (*v != "1" && *v != "2" && *v != "3") return "--degree needs 1, 2 or 3";
       command.degree = (*v)[0] - '0';
     } else if (arg == "--knot-spacing") {
-      double h = 0;
-      if (*v == "auto") {
-        command.knot_spacing.reset();
-      } else if (!parse_number(*v, h) || !(h > 0)) {
-        return "--knot-spacing needs a positive number or auto";
-      } else {
-        command.knot_spacing = h;
+      if (auto error = bireg_cli::parse_knot_spacing(*v, command.knot_spacing)) return error;
+    } else if (arg == "--roughness-penalty") {
+      if (auto error = bireg_cli::parse_roughness_penalty(*v, command.roughness_penalty)) {
+        return error;
       }
     } else if (arg == "--cv-table") {
       command.cv_table = *v;
@@ -355,7 +362,7 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
   }
   if (auto error = bireg_cli::check_input_options(command.input)) return error;
   // Each model's own options, refused with the other.
-  for (const char* option : {"--degree", "--knot-spacing", "--cv-table"}) {
+  for (const char* option : {"--degree", "--knot-spacing", "--roughness-penalty", "--cv-table"}) {
     if (!command.spline && given.count(option)) {
       return std::string(option) + " applies to --model spline only";
     }
@@ -377,8 +384,12 @@ std::optional<std::string> parse_command(int argc, char** argv, bireg_cli::FitCo
   }
   if (command.loss_scale > 0 && !command.loss) return "--loss-scale applies to --loss only";
   if (command.seed && command.permutations == 0) return "--seed goes with --permutations B";
-  if (command.cv_table.size() && command.knot_spacing) {
-    return "--cv-table goes with --knot-spacing auto";
+  if (command.degree == 1 && command.roughness_penalty != 0.0) {
+    return "--roughness-penalty needs --degree 2 or 3 (the penalty couples control points two "
+           "apart)";
+  }
+  if (command.cv_table.size() && command.knot_spacing && command.roughness_penalty) {
+    return "--cv-table goes with --knot-spacing auto or --roughness-penalty auto";
   }
   return std::nullopt;
 }

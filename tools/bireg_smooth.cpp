@@ -6,6 +6,7 @@
 //                [--times FILE] [--project]
 //                [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]
 //                [--method local|spline] [--degree 1|2|3] [--knot-spacing S|auto]
+//                [--roughness-penalty LAMBDA|auto]
 //                [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]
 //                [--output FILE] [--output-format matrix|tum|euroc|kitti]
 //                [--threads N] [--progress] FILE|-
@@ -26,7 +27,8 @@
 // degree, quadratic or cubic, is chosen with its bandwidth and printed).
 // It costs up to 60 smoothing passes, each window capped in turn
 // and in the kernel's support; --progress (or a terminal on stderr) shows
-// how far it is after two seconds.
+// how far it is after two seconds (and how far the spline's automatic knot
+// spacing or roughness penalty is, in fits).
 //
 // Where the trajectory is evaluated:
 //   default    at every input line's timestamp, in input order, each output
@@ -49,14 +51,22 @@
 // (select_knot_spacing over auto_knot_spacing_grid: 24 values from 1.25
 // median sample spacings to the whole range, 5 folds), printed on stderr,
 // and --cv-table FILE writes its curve (CSV: knot_spacing, criterion,
-// failures, refused). Poses and velocities are the spline's at the queries,
+// failures, refused). --roughness-penalty LAMBDA|auto (default 0: none;
+// degree 2 or 3) adds SplineOptions::roughness_penalty; auto chooses lambda
+// by the same cross-validation (select_roughness_penalty over
+// auto_roughness_penalty_grid) at the knot spacing given or, with
+// --knot-spacing auto, at fine_knot_spacing (1.5 median sample spacings,
+// not cross-validated), and --cv-table FILE writes that curve (CSV:
+// roughness_penalty, criterion, failures, refused); a penalised fit has no
+// velocity standard errors (spline_covariance refuses it, said on stderr).
+// Poses and velocities are the spline's at the queries,
 // the velocity's standard errors from the fit's sandwich covariance
 // (spline_covariance; empty fields, with the reason on stderr, where it is
 // undefined: noise-free data, no degrees of freedom, or more than 4096
 // control-point coordinates). A knot spacing the data cannot determine is invalid input (exit 2); a
 // fit that fails marks every row failed (exit 3). --bandwidth and --kernel apply to the local
-// method only, --degree and --knot-spacing to the spline only: the other method's options are
-// refused.
+// method only, --degree, --knot-spacing and --roughness-penalty to the spline only: the other
+// method's options are refused.
 //
 // --threads N (default: every core) shares the queries, and the
 // cross-validation of --bandwidth auto, out to N threads in blocks of 1024
@@ -116,6 +126,7 @@ constexpr const char* kUsage =
     "                    [--times FILE] [--project]\n"
     "                    [--bandwidth H|auto] [--kernel gaussian|epanechnikov|tricube]\n"
     "                    [--method local|spline] [--degree 1|2|3] [--knot-spacing S|auto]\n"
+    "                    [--roughness-penalty LAMBDA|auto]\n"
     "                    [--at FILE | --rate HZ] [--velocity FILE] [--cv-table FILE]\n"
     "                    [--output FILE] [--output-format matrix|tum|euroc|kitti]\n"
     "                    [--threads N] [--progress] FILE|-\n"
@@ -140,14 +151,18 @@ constexpr const char* kHelp =
     "  --degree K         the spline's degree, 1, 2 or 3 (default 3)\n"
     "  --knot-spacing S|auto  the spline's largest knot spacing in seconds; auto\n"
     "                     (default): cross-validation over 24 values from 1.25 median\n"
-    "                     sample spacings to the whole range, printed on stderr\n"
+    "                     sample spacings to the whole range, printed on stderr; with\n"
+    "                     --roughness-penalty auto: 1.5 median sample spacings\n"
+    "  --roughness-penalty LAMBDA|auto  the spline's second-difference penalty, >= 0\n"
+    "                     (default 0: none; degree 2 or 3); auto: cross-validation at\n"
+    "                     fine knots, printed on stderr (no velocity standard errors)\n"
     "  --at FILE          evaluate at the timestamps in FILE (one per line) instead of\n"
     "                     at every input timestamp\n"
     "  --rate HZ          evaluate at first + k / HZ up to the last timestamp\n"
     "  --velocity FILE    write the body velocity (rad/s; m/s for translations) with\n"
     "                     its standard errors and a status per row, as CSV\n"
     "  --cv-table FILE    write the cross-validation curves of --bandwidth auto (or of\n"
-    "                     --knot-spacing auto) as CSV\n"
+    "                     --knot-spacing auto, or of --roughness-penalty auto) as CSV\n"
     "  --output FILE      the smoothed poses (default: standard output)\n"
     "  --output-format F  their format (default: the input's)\n"
     "  --threads N        threads, 1 to 1024 (default: every core); the output does not\n"
@@ -169,9 +184,10 @@ struct Command {
   bireg_cli::InputOptions input;
   std::optional<double> bandwidth;  // empty: auto
   bireg::Kernel kernel = bireg::Kernel::gaussian;
-  bool spline = false;                 // --method spline
-  int degree = 3;                      // the spline's
-  std::optional<double> knot_spacing;  // empty: auto
+  bool spline = false;                            // --method spline
+  int degree = 3;                                 // the spline's
+  std::optional<double> knot_spacing;             // empty: auto
+  std::optional<double> roughness_penalty = 0.0;  // empty: auto
   // Options given that belong to one method only, for the refusal of the
   // other's.
   std::vector<std::string> local_options, spline_options;
@@ -237,13 +253,11 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
       command.degree = v[0] - '0';
     } else if (arg == "--knot-spacing") {
       command.spline_options.push_back(arg);
-      double h = 0;
-      if (v == "auto") {
-        command.knot_spacing.reset();
-      } else if (!parse_number(v, h) || !(h > 0)) {
-        return "--knot-spacing needs a positive number or auto";
-      } else {
-        command.knot_spacing = h;
+      if (auto error = bireg_cli::parse_knot_spacing(v, command.knot_spacing)) return error;
+    } else if (arg == "--roughness-penalty") {
+      command.spline_options.push_back(arg);
+      if (auto error = bireg_cli::parse_roughness_penalty(v, command.roughness_penalty)) {
+        return error;
       }
     } else if (arg == "--bandwidth") {
       command.local_options.push_back(arg);
@@ -290,6 +304,10 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   }
   if (!command.spline && !command.spline_options.empty()) {
     return command.spline_options.front() + " applies to --method spline only";
+  }
+  if (command.degree == 1 && command.roughness_penalty != 0.0) {
+    return "--roughness-penalty needs --degree 2 or 3 (the penalty couples control points two "
+           "apart)";
   }
   if (!command.at.empty() && command.rate) return "--at and --rate exclude each other";
   if (command.at == "-" && command.input.path == "-") {
@@ -471,7 +489,9 @@ std::optional<int> spline_estimates(const Command& command, const std::string& n
   SplineRequest request;
   request.degree = command.degree;
   request.knot_spacing = command.knot_spacing;
+  request.roughness_penalty = command.roughness_penalty;
   request.threads = command.threads;
+  request.progress = command.progress;
   request.cv_table = command.cv_table;
   SplineFit<G> spline_fit;
   if (auto code = fit_spline<G>("bireg_smooth", request, name, trajectory, spline_fit)) return code;

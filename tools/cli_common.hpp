@@ -63,6 +63,36 @@ inline std::optional<std::string> parse_threads(const std::string& text, int& th
   return std::nullopt;
 }
 
+// The spline's --knot-spacing S|auto: a positive number of seconds, or
+// auto (empty), or the message.
+inline std::optional<std::string> parse_knot_spacing(const std::string& text,
+                                                     std::optional<double>& spacing) {
+  double h = 0;
+  if (text == "auto") {
+    spacing.reset();
+  } else if (!parse_number(text, h) || !(h > 0)) {
+    return "--knot-spacing needs a positive number or auto, got " + bireg::io::quote_excerpt(text);
+  } else {
+    spacing = h;
+  }
+  return std::nullopt;
+}
+
+// The spline's --roughness-penalty LAMBDA|auto: a number >= 0 (0: none),
+// or auto (empty), or the message.
+inline std::optional<std::string> parse_roughness_penalty(const std::string& text,
+                                                          std::optional<double>& lambda) {
+  double value = 0;
+  if (text == "auto") {
+    lambda.reset();
+  } else if (!parse_number(text, value) || !(value >= 0)) {
+    return "--roughness-penalty needs a number >= 0 or auto, got " + bireg::io::quote_excerpt(text);
+  } else {
+    lambda = value;
+  }
+  return std::nullopt;
+}
+
 // The value of --format / --output-format, or the message naming the choices.
 inline std::optional<std::string> parse_format(const std::string& text,
                                                std::optional<bireg::io::Format>& format) {

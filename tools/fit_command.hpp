@@ -42,9 +42,10 @@ struct FitCommand {
   // --model spline: one cumulative B-spline of `degree` (fit_spline_run.cpp).
   bool spline = false;
   int degree = 3;
-  std::optional<double> knot_spacing;  // the largest, in seconds; empty: auto
-  std::string cv_table;                // --cv-table: the knot spacings' cross-validation
-  bool max_iterations_given = false;   // else the spline keeps SplineOptions' default
+  std::optional<double> knot_spacing;             // the largest, in seconds; empty: auto
+  std::optional<double> roughness_penalty = 0.0;  // lambda; empty: auto
+  std::string cv_table;                           // --cv-table: the knot spacings' cross-validation
+  bool max_iterations_given = false;              // else the spline keeps SplineOptions' default
 };
 
 // Reads the input as G, fits it (robustly with --loss), writes

@@ -29,15 +29,17 @@ int fail(const std::string& message) {
   return kExitInvalid;
 }
 
-// "candidates": one object per knot spacing tried, with its criterion or
-// the reason it was refused (never a NaN or null).
-std::string selection_json(const bireg::KnotSpacingSelection<double>& selection) {
-  std::string text = "{\"chosen\": " + json_number(selection.knot_spacing) +
+// "candidates": one object per knot spacing (or lambda) on the grid, with
+// its criterion or the reason it was refused (never a NaN or null).
+// `key` names the grid's value ("knot_spacing" or "roughness_penalty").
+template <class Selection>
+std::string selection_json(const Selection& selection, double chosen, const char* key) {
+  std::string text = "{\"chosen\": " + json_number(chosen) +
                      ", \"at_edge\": " + (selection.at_edge ? "true" : "false") +
                      ", \"candidates\": [";
   for (std::size_t k = 0; k < selection.grid.size(); ++k) {
-    text += std::string(k ? ",\n   " : "\n   ") +
-            "{\"knot_spacing\": " + json_number(selection.grid[k]);
+    text +=
+        std::string(k ? ",\n   " : "\n   ") + "{\"" + key + "\": " + json_number(selection.grid[k]);
     if (selection.refusals[k].empty()) {
       text += ", \"criterion\": " + json_number(selection.criterion[k]);
     } else {
@@ -60,6 +62,7 @@ int run(const FitCommand& command) {
   SplineRequest request;
   request.degree = command.degree;
   request.knot_spacing = command.knot_spacing;
+  request.roughness_penalty = command.roughness_penalty;
   request.tolerance = command.tolerance;
   if (command.max_iterations_given) request.max_iterations = command.max_iterations;
   request.threads = command.threads;
@@ -98,6 +101,9 @@ int run(const FitCommand& command) {
           ? trajectory.lines[static_cast<std::size_t>(fit.largest_residual_observation)]
           : 0;
   const double final_step = fit.step_norms.empty() ? 0.0 : fit.step_norms.back();
+  // "fine": --knot-spacing auto with --roughness-penalty auto
+  // (fine_knot_spacing, no cross-validation of the spacing).
+  const char* knot_source = spline_fit.selection ? "auto" : command.knot_spacing ? "given" : "fine";
   const std::string projection =
       projection_json(command.input.project, trajectory.projection_correction);
   std::printf(
@@ -106,6 +112,7 @@ int run(const FitCommand& command) {
       " \"status\": \"%s\", \"iterations\": %d, \"final_step_norm\": %s, "
       "\"equation_norm\": %s,\n"
       " \"degree\": %d, \"knot_spacing\": %s, \"knot_spacing_source\": \"%s\",\n"
+      " \"roughness_penalty\": %s, \"roughness_penalty_source\": \"%s\",\n"
       " \"knots\": [%s],\n"
       " \"control_points\": [%s],\n"
       " \"diagnostics\": {\"largest_residual_angle\": %s, \"largest_residual_line\": %llu, "
@@ -115,13 +122,24 @@ int run(const FitCommand& command) {
       io::render_timestamp(trajectory.last, io::TimeUnit::seconds).c_str(),
       bireg::to_string(fit.status), fit.iterations, json_number(final_step).c_str(),
       json_number(fit.equation_norm).c_str(), spline.degree(),
-      json_number(spline.knot_spacing()).c_str(), spline_fit.selection ? "auto" : "given",
+      json_number(spline.knot_spacing()).c_str(), knot_source,
+      json_number(fit.roughness_penalty).c_str(), spline_fit.roughness_selection ? "auto" : "given",
       knots.c_str(), points.c_str(), json_number(fit.largest_residual_angle).c_str(),
       static_cast<unsigned long long>(farthest_line),
       json_number(fit.largest_increment_angle).c_str(), fit.largest_increment,
       fit.beyond_domain ? "true" : "false");
   if (spline_fit.selection) {
-    std::printf(",\n \"knot_selection\": %s", selection_json(*spline_fit.selection).c_str());
+    std::printf(
+        ",\n \"knot_selection\": %s",
+        selection_json(*spline_fit.selection, spline_fit.selection->knot_spacing, "knot_spacing")
+            .c_str());
+  }
+  if (spline_fit.roughness_selection) {
+    std::printf(
+        ",\n \"roughness_selection\": %s",
+        selection_json(*spline_fit.roughness_selection,
+                       spline_fit.roughness_selection->roughness_penalty, "roughness_penalty")
+            .c_str());
   }
   std::printf("}\n");
   if (!stdout_written("bireg_fit")) return kExitWriteError;

@@ -34,6 +34,22 @@ std::optional<std::string> write_knot_table(const std::string& path,
   return bireg_cli::write_text_file(path, text);
 }
 
+// The same for --roughness-penalty auto, one row per lambda.
+std::optional<std::string> write_roughness_table(
+    const std::string& path, const bireg::RoughnessPenaltySelection<double>& selection) {
+  std::string text = "roughness_penalty,criterion,failures,refused\n";
+  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
+    bireg::io::append_double(text, selection.grid[k]);
+    text += ',';
+    if (std::isfinite(selection.criterion[k])) {
+      bireg::io::append_double(text, selection.criterion[k]);
+    }
+    text += ',' + std::to_string(selection.failures[k]) + ',' +
+            bireg_cli::csv_field(selection.refusals[k]) + '\n';
+  }
+  return bireg_cli::write_text_file(path, text);
+}
+
 int fail(const char* tool, const std::string& message) {
   std::fprintf(stderr, "%s: %s\n", tool, message.c_str());
   return kExitInvalid;
@@ -52,12 +68,26 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
   if (request.tolerance) options.tolerance = *request.tolerance;
   if (request.max_iterations) options.max_iterations = *request.max_iterations;
   out.selection.reset();
+  out.roughness_selection.reset();
+  const bool roughness_auto = !request.roughness_penalty.has_value();
   if (request.knot_spacing) {
     options.knot_spacing = *request.knot_spacing;
+  } else if (roughness_auto) {
+    // Fine knots, lambda does the smoothing: no knot spacing to choose.
+    options.knot_spacing = bireg::fine_knot_spacing(trajectory.covariates);
+    std::fprintf(stderr,
+                 "%s: knot spacing auto with --roughness-penalty auto: %s s (1.5 median sample "
+                 "spacings)\n",
+                 tool, io::json_number(options.knot_spacing).c_str());
   } else {
     const std::vector<double> grid = bireg::auto_knot_spacing_grid(trajectory.covariates);
-    out.selection = bireg::select_knot_spacing<G>(trajectory.observations, trajectory.covariates,
-                                                  options, grid);
+    Progress progress(tool, request.progress);
+    out.selection =
+        bireg::select_knot_spacing<G>(trajectory.observations, trajectory.covariates, options, grid,
+                                      5, [&](std::size_t done, std::size_t total) {
+                                        progress.update("knot spacing auto", done, total);
+                                      });
+    progress.finish();
     const bireg::KnotSpacingSelection<double>& selection = *out.selection;
     if (!request.cv_table.empty()) {
       if (auto error = write_knot_table(request.cv_table, selection)) {
@@ -76,6 +106,44 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
                  io::json_number(grid.front()).c_str(), io::json_number(grid.back()).c_str());
     if (!selection.message.empty()) {
       std::fprintf(stderr, "%s: warning: knot spacing auto: %s\n", tool, selection.message.c_str());
+    }
+  }
+  if (!roughness_auto) {
+    options.roughness_penalty = *request.roughness_penalty;
+  } else {
+    const std::vector<double> grid =
+        bireg::auto_roughness_penalty_grid(trajectory.covariates, double(options.knot_spacing));
+    Progress progress(tool, request.progress);
+    out.roughness_selection =
+        bireg::select_roughness_penalty<G>(trajectory.observations, trajectory.covariates, options,
+                                           grid, 5, [&](std::size_t done, std::size_t total) {
+                                             progress.update("roughness penalty auto", done, total);
+                                           });
+    progress.finish();
+    const bireg::RoughnessPenaltySelection<double>& selection = *out.roughness_selection;
+    if (!request.cv_table.empty()) {
+      if (auto error = write_roughness_table(request.cv_table, selection)) {
+        std::fprintf(stderr, "%s: %s\n", tool, error->c_str());
+        return kExitWriteError;
+      }
+    }
+    if (!selection.ok()) {
+      return fail(tool, name + ": roughness penalty auto: " + selection.message +
+                            ": give --roughness-penalty LAMBDA or a wider --knot-spacing");
+    }
+    options.roughness_penalty = selection.roughness_penalty;
+    std::size_t tried = 0;
+    for (const std::string& refusal : selection.refusals)
+      tried += refusal.rfind("not tried", 0) == 0 ? 0 : 1;
+    std::fprintf(stderr,
+                 "%s: roughness penalty auto: %s (cross-validation over %zu of %zu values from "
+                 "%s to %s)\n",
+                 tool, io::json_number(selection.roughness_penalty).c_str(), tried,
+                 selection.grid.size(), io::json_number(selection.grid.front()).c_str(),
+                 io::json_number(selection.grid.back()).c_str());
+    if (!selection.message.empty()) {
+      std::fprintf(stderr, "%s: warning: roughness penalty auto: %s\n", tool,
+                   selection.message.c_str());
     }
   }
   out.fit = bireg::SplineRegression<G>(options).fit(trajectory.observations, trajectory.covariates);

@@ -11,16 +11,26 @@
 #include "bireg/io/formats.hpp"
 #include "bireg/spline_regression.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
+#include "bireg/statistics/smoothing/spline_roughness.hpp"
 
 namespace bireg_cli {
 
 struct SplineRequest {
   int degree = 3;
   std::optional<double> knot_spacing;  // the largest spacing in seconds; empty: auto
-  std::optional<double> tolerance;     // empty: SplineOptions' default
-  std::optional<int> max_iterations;   // empty: SplineOptions' default
+  // lambda of the roughness penalty (SplineOptions::roughness_penalty);
+  // empty: auto, by cross-validation at the knot spacing given or, with
+  // none, at fine_knot_spacing.
+  std::optional<double> roughness_penalty = 0.0;
+  std::optional<double> tolerance;    // empty: SplineOptions' default
+  std::optional<int> max_iterations;  // empty: SplineOptions' default
   int threads = 1;
-  std::string cv_table;  // auto only: where to write the cross-validation table (empty: nowhere)
+  // Progress of an automatic choice on stderr even when it is not a
+  // terminal (bireg_cli::Progress; on a terminal it is always shown).
+  bool progress = false;
+  // An automatic knot spacing or penalty only: where to write its
+  // cross-validation table (empty: nowhere).
+  std::string cv_table;
 };
 
 template <class G>
@@ -28,10 +38,15 @@ struct SplineFit {
   bireg::SplineResult<G> fit;
   // With an automatic knot spacing: the cross-validation that chose it.
   std::optional<bireg::KnotSpacingSelection<double>> selection;
+  // With an automatic roughness penalty: the cross-validation that chose it.
+  std::optional<bireg::RoughnessPenaltySelection<double>> roughness_selection;
 };
 
 // Chooses the knot spacing (the one given, or by cross-validation over
-// auto_knot_spacing_grid, the choice said on one line of stderr), fits one
+// auto_knot_spacing_grid, the choice said on one line of stderr) and the
+// roughness penalty (the one given, or by cross-validation over
+// auto_roughness_penalty_grid at the knot spacing given or at
+// fine_knot_spacing, said on stderr likewise), fits one
 // spline to the trajectory and warns on stderr where it comes near the
 // principal log's cut locus; every line on stderr starts with "<tool>: ".
 // Returns an exit code when the tool cannot go on, its reason printed:
