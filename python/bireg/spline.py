@@ -18,7 +18,14 @@ class SplineRegression:
     """``degree`` 1 (piecewise geodesic), 2 or 3; ``knot_spacing`` the largest
     spacing of the uniform knots in covariate units, or ``"auto"``: chosen
     by cross-validation (``bireg::select_knot_spacing`` over
-    ``auto_knot_spacing_grid``), its curve in ``knot_selection_``. ``tol``
+    ``auto_knot_spacing_grid``), its curve in ``knot_selection_``.
+    ``roughness_penalty`` lambda >= 0 of the second-difference penalty
+    (``SplineOptions::roughness_penalty``, docs/splines.md §12; degree 2 or
+    3; 0: none), or ``"auto"``: chosen by cross-validation
+    (``bireg::select_roughness_penalty`` over
+    ``auto_roughness_penalty_grid``) at the knot spacing given or, with
+    ``knot_spacing="auto"``, at fine knots (``fine_knot_spacing``: 1.5
+    median sample spacings), its curve in ``roughness_selection_``. ``tol``
     and ``max_iter`` of the Gauss-Newton iteration; ``threads`` for its
     passes (results do not depend on it).
 
@@ -26,20 +33,23 @@ class SplineRegression:
     ``first_knot_``, ``knot_spacing_`` (the spacing used: the range cut into
     equal segments no longer than asked), ``status_``, ``n_iter_``,
     ``equation_norm_``, ``residuals_`` (N, d), ``knot_selection_`` (a dict
-    for "auto", else None), ``diagnostics_`` (a dict: the largest residual
+    for "auto", else None), ``roughness_penalty_`` (the lambda used),
+    ``roughness_selection_`` (a dict for "auto", else None),
+    ``diagnostics_`` (a dict: the largest residual
     and knot-span angles and where they are, and ``beyond_domain``: either
     past 3 pi / 4, near the log's cut locus; a UserWarning says so), and of the sandwich covariance of the control
     points (``bireg::spline_covariance``, docs/splines.md §10):
     ``noise_covariance_`` (d, d) and ``degrees_of_freedom_`` (N - M for
-    unit weights), None where it is undefined, with the reason in
-    ``covariance_message_``.
+    unit weights), None where it is undefined (a penalised fit among the
+    reasons), with the reason in ``covariance_message_``.
     """
 
-    def __init__(self, group="SE3", degree=3, knot_spacing="auto", tol=1e-10, max_iter=100,
-                 threads=1):
+    def __init__(self, group="SE3", degree=3, knot_spacing="auto", roughness_penalty=0.0,
+                 tol=1e-10, max_iter=100, threads=1):
         self.group = group
         self.degree = degree
         self.knot_spacing = knot_spacing
+        self.roughness_penalty = roughness_penalty
         self.tol = tol
         self.max_iter = max_iter
         self.threads = threads
@@ -63,7 +73,19 @@ class SplineRegression:
             if not spacing > 0:
                 raise ValueError("knot_spacing must be a positive number (inf: one segment) or "
                                  f"'auto', got {self.knot_spacing!r}")
-        out = _bireg.spline_fit(group.name, t, Y, w, degree, spacing, float(self.tol),
+        roughness_auto = isinstance(self.roughness_penalty, str)
+        if roughness_auto:
+            if self.roughness_penalty != "auto":
+                raise ValueError("roughness_penalty must be 'auto' or a number >= 0, got "
+                                 f"{self.roughness_penalty!r}")
+            roughness = 0.0
+        else:
+            roughness = float(self.roughness_penalty)
+            if not (roughness >= 0 and np.isfinite(roughness)):
+                raise ValueError("roughness_penalty must be a finite number >= 0 or 'auto', "
+                                 f"got {self.roughness_penalty!r}")
+        out = _bireg.spline_fit(group.name, t, Y, w, degree, spacing, roughness, roughness_auto,
+                                float(self.tol),
                                 _arrays.positive_int(self.max_iter, "max_iter"),
                                 _arrays.positive_int(self.threads, "threads"))
         self.control_points_ = out["control_points"]
@@ -75,6 +97,8 @@ class SplineRegression:
         self.residuals_ = out["residuals"]
         self.diagnostics_ = out["diagnostics"]
         self.knot_selection_ = out.get("knot_selection")
+        self.roughness_penalty_ = out["roughness_penalty"]
+        self.roughness_selection_ = out.get("roughness_selection")
         self.noise_covariance_ = out.get("noise_covariance")
         self.degrees_of_freedom_ = out.get("degrees_of_freedom")
         self.covariance_message_ = out["covariance_message"]
@@ -83,6 +107,9 @@ class SplineRegression:
         if self.knot_selection_ is not None and self.knot_selection_["message"]:
             warnings.warn(f"knot spacing auto: {self.knot_selection_['message']}", UserWarning,
                           stacklevel=2)
+        if self.roughness_selection_ is not None and self.roughness_selection_["message"]:
+            warnings.warn(f"roughness penalty auto: {self.roughness_selection_['message']}",
+                          UserWarning, stacklevel=2)
         if self.diagnostics_["beyond_domain"] and self.status_ in _SUCCESS:
             d = self.diagnostics_
             warnings.warn(

@@ -11,6 +11,7 @@
 #include "bireg/spline_regression.hpp"
 #include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
+#include "bireg/statistics/smoothing/spline_roughness.hpp"
 #include "common.hpp"
 
 namespace bireg_python {
@@ -25,11 +26,33 @@ Output element_stack(const std::vector<typename G::Element>& elements) {
   return stack.release();
 }
 
+// The cross-validation curve of a selection, as a dict: the choice under
+// `key`, the grid, the criterion (inf where refused), the refusals and the
+// message.
+template <class Selection>
+nb::dict selection_dict(const Selection& selection, const char* key, double chosen) {
+  nb::dict out;
+  out[key] = chosen;
+  out["grid"] = vector_array(selection.grid);
+  out["criterion"] = vector_array(selection.criterion);
+  nb::list refusals;
+  for (const std::string& r : selection.refusals)
+    refusals.append(r);
+  out["refusals"] = refusals;
+  out["at_edge"] = selection.at_edge;
+  out["message"] = selection.message;
+  return out;
+}
+
 // knot_spacing <= 0: chosen by select_knot_spacing over
-// auto_knot_spacing_grid, the curve returned under "knot_selection".
+// auto_knot_spacing_grid, the curve returned under "knot_selection";
+// with roughness_auto, fine_knot_spacing instead. roughness_auto: lambda
+// chosen by select_roughness_penalty over auto_roughness_penalty_grid, the
+// curve under "roughness_selection"; else roughness_penalty as given.
 template <class G>
 nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree,
-                    double knot_spacing, double tolerance, int max_iterations, int threads) {
+                    double knot_spacing, double roughness_penalty, bool roughness_auto,
+                    double tolerance, int max_iterations, int threads) {
   const StackView<G> poses(y);
   const std::vector<double> covariates = to_vector(t), weights = to_vector(w);
   bireg::SplineOptions<double> options;
@@ -41,37 +64,45 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
   bireg::SplineResult<G> fit;
   bireg::SplineCovariance<G> covariance;
   bireg::KnotSpacingSelection<double> selection;
-  const bool automatic = !(knot_spacing > 0);
+  bireg::RoughnessPenaltySelection<double> roughness;
+  const bool automatic = !(knot_spacing > 0) && !roughness_auto;
   {
     nb::gil_scoped_release release;
     if (automatic) {
       selection = bireg::select_knot_spacing<G>(poses, covariates, options,
                                                 bireg::auto_knot_spacing_grid(covariates));
       options.knot_spacing = selection.knot_spacing;
-    } else {
+    } else if (knot_spacing > 0) {
       options.knot_spacing = knot_spacing;
+    } else {
+      options.knot_spacing = bireg::fine_knot_spacing(covariates);
     }
-    if (!automatic || selection.ok())
+    if (roughness_auto) {
+      roughness = bireg::select_roughness_penalty<G>(
+          poses, covariates, options,
+          bireg::auto_roughness_penalty_grid(covariates, double(options.knot_spacing)));
+      options.roughness_penalty = roughness.roughness_penalty;
+    } else {
+      options.roughness_penalty = roughness_penalty;
+    }
+    if ((!automatic || selection.ok()) && (!roughness_auto || roughness.ok()))
       fit = bireg::SplineRegression<G>(options).fit(poses, covariates, weights);
     if (fit.ok()) covariance = bireg::spline_covariance(fit, poses, covariates, weights);
   }
   if (automatic) {
     if (!selection.ok()) refuse("knot spacing auto: " + selection.message);
-    nb::dict knots;
-    knots["knot_spacing"] = selection.knot_spacing;
-    knots["grid"] = vector_array(selection.grid);
-    knots["criterion"] = vector_array(selection.criterion);
-    nb::list refusals;
-    for (const std::string& r : selection.refusals)
-      refusals.append(r);
-    knots["refusals"] = refusals;
-    knots["message"] = selection.message;
-    out["knot_selection"] = knots;
+    out["knot_selection"] = selection_dict(selection, "knot_spacing", selection.knot_spacing);
+  }
+  if (roughness_auto) {
+    if (!roughness.ok()) refuse("roughness penalty auto: " + roughness.message);
+    out["roughness_selection"] =
+        selection_dict(roughness, "roughness_penalty", roughness.roughness_penalty);
   }
   if (fit.status == bireg::Status::invalid_input) refuse(fit.message);
   out["status"] = std::string(to_string(fit.status));
   out["message"] = fit.message;
   out["iterations"] = fit.iterations;
+  out["roughness_penalty"] = fit.roughness_penalty;
   out["equation_norm"] = fit.equation_norm;
   out["first_knot"] = fit.spline->first_knot();
   out["knot_spacing"] = fit.spline->knot_spacing();
@@ -180,15 +211,20 @@ void bind_spline(nb::module_& m) {
   m.def(
       "spline_fit",
       [](const std::string& group, const Vector& t, const Stack& y, const Vector& w, int degree,
-         double knot_spacing, double tolerance, int max_iterations, int threads) {
+         double knot_spacing, double roughness_penalty, bool roughness_auto, double tolerance,
+         int max_iterations, int threads) {
         return with_group(group, [&](auto tag) {
-          return fit_spline<typename decltype(tag)::type>(t, y, w, degree, knot_spacing, tolerance,
-                                                          max_iterations, threads);
+          return fit_spline<typename decltype(tag)::type>(t, y, w, degree, knot_spacing,
+                                                          roughness_penalty, roughness_auto,
+                                                          tolerance, max_iterations, threads);
         });
       },
       nb::arg("group"), nb::arg("t"), nb::arg("y"), nb::arg("weights"), nb::arg("degree"),
-      nb::arg("knot_spacing"), nb::arg("tol"), nb::arg("max_iter"), nb::arg("threads"),
-      "bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing).");
+      nb::arg("knot_spacing"), nb::arg("roughness_penalty"), nb::arg("roughness_auto"),
+      nb::arg("tol"), nb::arg("max_iter"), nb::arg("threads"),
+      "bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing, or "
+      "fine_knot_spacing with roughness_auto; roughness_auto: lambda by "
+      "select_roughness_penalty).");
   m.def(
       "spline_evaluate",
       [](const std::string& group, int degree, double first_knot, double spacing,

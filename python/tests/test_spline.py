@@ -1,8 +1,11 @@
 """SplineRegression through Python: a geodesic reproduced with its velocity,
 degree 1 with one segment equal to GeodesicRegression, left and right
-equivariance, the knot spacing by cross-validation, the confidence bands
+equivariance, the knot spacing and the roughness penalty by
+cross-validation, the confidence bands
 (one segment's against the geodesic's), and ValueError for what the C++
 refuses."""
+
+import warnings
 
 import numpy as np
 import pytest
@@ -68,6 +71,39 @@ def test_auto_knot_spacing_reports_its_curve(rng):
     assert all(bool(r) for r, ok in zip(selection["refusals"], valid) if not ok)
 
 
+def test_auto_roughness_penalty_reports_its_curve_and_is_reproducible(rng):
+    # Noisy data about one geodesic, evenly spaced: a geodesic is in the
+    # penalty's null space (every second difference of its increments is
+    # zero), so cross-validation chooses a strong penalty: at least 10
+    # times the 1.5 observations per knot span (a window of about 1.8
+    # spans; beyond some lambda the criterion is flat up to its noise).
+    # Fine knots: 1.5 sample spacings.
+    n = 150
+    t = np.linspace(0.0, 1.0, n)
+    _, Y = geodesic_data("SO3", n, rng)
+    Y = bireg.SO3.compose(bireg.SO3.exp(0.8 * t[:, None] * np.array([1.0, -0.5, 0.3])), Y)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        spline = bireg.SplineRegression(group="SO3", roughness_penalty="auto").fit(t, Y)
+    assert spline.knot_selection_ is None
+    assert 0.95 * 1.5 / (n - 1) < spline.knot_spacing_ <= 1.5 / (n - 1) * (1 + 1e-12)
+    selection = spline.roughness_selection_
+    valid = np.isfinite(selection["criterion"])
+    chosen = int(np.flatnonzero(selection["grid"] == selection["roughness_penalty"])[0])
+    assert selection["criterion"][chosen] == selection["criterion"][valid].min()
+    assert spline.roughness_penalty_ == selection["roughness_penalty"] >= 10 * 1.5
+    # A choice at the grid's edge, and only that, is warned about.
+    warned = [w for w in caught if "roughness penalty auto" in str(w.message)]
+    assert len(warned) == (1 if selection["at_edge"] else 0)
+    # The same lambda and knots given by hand: the same fit, bit for bit.
+    given = bireg.SplineRegression(group="SO3", knot_spacing=1.5 / (n - 1),
+                                   roughness_penalty=spline.roughness_penalty_).fit(t, Y)
+    np.testing.assert_array_equal(given.control_points_, spline.control_points_)
+    # A penalised fit has no sandwich band, and says why.
+    with pytest.raises(ValueError, match="roughness penalty"):
+        spline.confidence_band(t[:3])
+
+
 def test_refusals_are_value_errors(rng):
     t, Y = geodesic_data("SO3", 30, rng)
     with pytest.raises(ValueError, match="control points for 30 observations"):
@@ -78,6 +114,14 @@ def test_refusals_are_value_errors(rng):
         bireg.SplineRegression(group="SO3", knot_spacing="wide").fit(t, Y)
     with pytest.raises(ValueError, match="knot_spacing must be"):
         bireg.SplineRegression(group="SO3", knot_spacing=-1.0).fit(t, Y)
+    for bad in ("smooth", -1.0, np.nan):
+        with pytest.raises(ValueError, match="roughness_penalty must be"):
+            bireg.SplineRegression(group="SO3", roughness_penalty=bad).fit(t, Y)
+    with pytest.raises(ValueError, match="degree 2 or 3"):
+        bireg.SplineRegression(group="SO3", degree=1, knot_spacing=0.5,
+                               roughness_penalty=1.0).fit(t, Y)
+    with pytest.raises(ValueError, match="roughness penalty auto: .*degree 2 or 3"):
+        bireg.SplineRegression(group="SO3", degree=1, roughness_penalty="auto").fit(t, Y)
     Y_bad = Y.copy()
     Y_bad[4, 0, 0] = np.nan
     with pytest.raises(ValueError, match="observation 4"):
