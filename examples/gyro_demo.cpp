@@ -24,7 +24,11 @@
 //     smoothed at the velocity's choice;
 //   the cubic spline: SplineRegression<SO3>, degree 3, its knot spacing by
 //     select_knot_spacing over auto_knot_spacing_grid (5 folds), its
-//     velocity at every sample.
+//     velocity at every sample;
+//   the penalised cubic spline: the same at fine knots (fine_knot_spacing,
+//     1.5 median sample spacings) with the roughness penalty chosen by
+//     select_roughness_penalty over auto_roughness_penalty_grid, what
+//     `bireg_smooth --method spline --roughness-penalty auto` does.
 // Prints the RMS error |w - w_gyro| over all samples (rad/s) and the chosen
 // bandwidths: for the 128 Hz recording, for it subsampled to 50 and 25 Hz
 // (fast relative to the sampling: up to 0.2 and 0.4 rad between samples),
@@ -48,6 +52,7 @@
 #include "bireg/statistics/inference/spline_covariance.hpp"
 #include "bireg/statistics/smoothing/local_regression.hpp"
 #include "bireg/statistics/smoothing/spline_knots.hpp"
+#include "bireg/statistics/smoothing/spline_roughness.hpp"
 #include "bireg/testing/fast_motion.hpp"
 #include "svg_plot.hpp"
 
@@ -183,6 +188,28 @@ std::string spline_cell(const std::vector<SO3::Element>& r, const std::vector<do
   return cell;
 }
 
+// The penalised cubic spline's column: its velocity's RMS error at fine
+// knots and the lambda chosen by cross-validation
+// (statistics/smoothing/spline_roughness.hpp), or why there is none.
+std::string penalised_spline_cell(const std::vector<SO3::Element>& r, const std::vector<double>& t,
+                                  const std::vector<Vector3>& truth) {
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = bireg::fine_knot_spacing(t);
+  const auto selection = bireg::select_roughness_penalty<SO3>(
+      r, t, options, bireg::auto_roughness_penalty_grid(t, double(options.knot_spacing)));
+  if (!selection.ok()) return "no penalty: " + selection.message;
+  options.roughness_penalty = selection.roughness_penalty;
+  const auto fit = bireg::SplineRegression<SO3>(options).fit(r, t);
+  if (!fit.ok()) return std::string("failed: ") + bireg::to_string(fit.status);
+  std::vector<Vector3> velocity;
+  for (const double ti : t)
+    velocity.push_back(fit.spline->body_velocity(ti));
+  char cell[48];
+  std::snprintf(cell, sizeof cell, "%.3f (%.2g)", rms_error(velocity, truth),
+                selection.roughness_penalty);
+  return cell;
+}
+
 // The spline's picture: over [from, to] seconds, one panel per axis with
 // the gyroscope and the spline's velocity inside its pointwise 95% band.
 bool write_spline_svg(const std::string& path, double from, double to, double noise,
@@ -241,11 +268,11 @@ std::vector<Vector3> print_row(const std::string& label, double noise,
                  label.c_str(), noise, smoothed.failed);
     return {};
   }
-  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f, %s | %.2f | %s |\n",
+  std::printf("| %s | %g | %.3f | %.3f (%.4f) | %.3f | %.4f, %.4f, %s | %.2f | %s | %s |\n",
               label.c_str(), noise, rms_error(differences, truth), chart, chart_bandwidth,
               rms_error(smoothed.velocity, truth), smoothed.pose_bandwidth, smoothed.bandwidth,
               smoothed.degree == 3 ? "cubic" : "quadratic", smoothed.mean_iterations,
-              spline_cell(r, t, truth, spline).c_str());
+              spline_cell(r, t, truth, spline).c_str(), penalised_spline_cell(r, t, truth).c_str());
   return smoothed.velocity;
 }
 
@@ -278,8 +305,9 @@ int main(int argc, char** argv) {
       "| recording | orientation noise (rad) | finite differences RMS (rad/s) | chart line "
       "RMS, best bandwidth (s) | bireg RMS (rad/s) | bireg bandwidths, pose and velocity (s), "
       "velocity's degree "
-      "| GN iterations per query | cubic spline RMS, knot spacing (s) |\n"
-      "|---|---|---|---|---|---|---|---|\n";
+      "| GN iterations per query | cubic spline RMS, knot spacing (s) | penalised cubic spline "
+      "RMS, lambda |\n"
+      "|---|---|---|---|---|---|---|---|---|\n";
   std::printf("%s", header);
   std::mt19937 rng(20261123);
   std::normal_distribution<double> normal(0.0, 1.0);
