@@ -39,6 +39,44 @@ using bireg_test::random_points;
 using bireg_test::sample;
 using bireg_test::Samples;
 
+// The control points of weighted least-squares B-spline regression in R^3
+// with the second-difference penalty, (B^T W B + lambda D_2^T D_2) P =
+// B^T W F with weights normalised to a largest of 1 (as fit() does),
+// solved densely on `curve`'s knots; and the condition number of that
+// matrix, for the tolerance of a comparison.
+struct DenseSolution {
+  Eigen::MatrixXd points;
+  double condition = 1;
+};
+
+DenseSolution dense_penalised_solution(const bireg::Spline<R3>& curve, const std::vector<double>& t,
+                                       const std::vector<R3::Element>& f,
+                                       const std::vector<double>& w, double lambda) {
+  const int k = curve.degree();
+  const std::size_t m = curve.control_points().size();
+  const double largest_weight = *std::max_element(w.begin(), w.end());
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(m, m), rhs = Eigen::MatrixXd::Zero(m, 3);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const auto at = curve.position(t[i]);
+    const auto basis = bireg::spline_basis(k, at.u);
+    const double weight = w[i] / largest_weight;
+    for (int a = 0; a <= k; ++a) {
+      rhs.row(at.segment + a) += weight * basis.ordinary[a] * f[i].transpose();
+      for (int b = 0; b <= k; ++b)
+        normal(at.segment + a, at.segment + b) += weight * basis.ordinary[a] * basis.ordinary[b];
+    }
+  }
+  if (lambda > 0) {
+    Eigen::MatrixXd second = Eigen::MatrixXd::Zero(m - 2, m);
+    for (std::size_t c = 0; c + 2 < m; ++c)
+      second.row(c).segment(c, 3) << 1, -2, 1;
+    normal += lambda * second.transpose() * second;
+  }
+  const Eigen::VectorXd eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(normal).eigenvalues();
+  return {normal.ldlt().solve(rhs), eigenvalues.maxCoeff() / eigenvalues.minCoeff()};
+}
+
 }  // namespace
 
 TEST_CASE("Spline basis: partition of unity and derivatives against differences", "[spline]") {
@@ -250,19 +288,8 @@ TEST_CASE("Spline fit in R^3 is least-squares B-spline regression", "[spline]") 
     const auto fit = bireg::SplineRegression<R3>(options).fit(f, t, w);
     REQUIRE(fit.ok());
     const auto& curve = *fit.spline;
-    const std::size_t m = curve.control_points().size();
-    Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(m, m), rhs = Eigen::MatrixXd::Zero(m, 3);
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      const auto at = curve.position(t[i]);
-      const auto basis = bireg::spline_basis(k, at.u);
-      for (int a = 0; a <= k; ++a) {
-        rhs.row(at.segment + a) += w[i] * basis.ordinary[a] * f[i].transpose();
-        for (int b = 0; b <= k; ++b)
-          normal(at.segment + a, at.segment + b) += w[i] * basis.ordinary[a] * basis.ordinary[b];
-      }
-    }
-    const Eigen::MatrixXd solution = normal.ldlt().solve(rhs);
-    for (std::size_t c = 0; c < m; ++c)
+    const Eigen::MatrixXd solution = dense_penalised_solution(curve, t, f, w, 0.0).points;
+    for (std::size_t c = 0; c < curve.control_points().size(); ++c)
       CHECK((curve.control_points()[c] - solution.row(c).transpose()).norm() < 1e-12);
   }
 }
@@ -284,7 +311,6 @@ TEST_CASE("Spline fit in R^3 with a roughness penalty solves the penalised norma
     f.push_back(R3::Element(std::sin(t.back()), std::cos(0.7 * t.back()), 0.1 * t.back()) +
                 bireg_test::normal_tangent<R3::Tangent>(rng, 0.1));
   }
-  const double largest_weight = *std::max_element(w.begin(), w.end());
   for (const int k : {2, 3}) {
     for (const double lambda : {1e-3, 1.0, 1e3}) {
       bireg::SplineOptions<double> options;
@@ -295,26 +321,9 @@ TEST_CASE("Spline fit in R^3 with a roughness penalty solves the penalised norma
       INFO("degree " << k << " lambda " << lambda);
       REQUIRE(fit.ok());
       const auto& curve = *fit.spline;
-      const std::size_t m = curve.control_points().size();
-      Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(m, m), rhs = Eigen::MatrixXd::Zero(m, 3);
-      for (std::size_t i = 0; i < t.size(); ++i) {
-        const auto at = curve.position(t[i]);
-        const auto basis = bireg::spline_basis(k, at.u);
-        const double weight = w[i] / largest_weight;
-        for (int a = 0; a <= k; ++a) {
-          rhs.row(at.segment + a) += weight * basis.ordinary[a] * f[i].transpose();
-          for (int b = 0; b <= k; ++b)
-            normal(at.segment + a, at.segment + b) +=
-                weight * basis.ordinary[a] * basis.ordinary[b];
-        }
-      }
-      Eigen::MatrixXd second = Eigen::MatrixXd::Zero(m - 2, m);
-      for (std::size_t c = 0; c + 2 < m; ++c)
-        second.row(c).segment(c, 3) << 1, -2, 1;
-      normal += lambda * second.transpose() * second;
-      const Eigen::MatrixXd solution = normal.ldlt().solve(rhs);
+      const Eigen::MatrixXd solution = dense_penalised_solution(curve, t, f, w, lambda).points;
       const double scale = solution.cwiseAbs().maxCoeff();
-      for (std::size_t c = 0; c < m; ++c)
+      for (std::size_t c = 0; c < curve.control_points().size(); ++c)
         CHECK((curve.control_points()[c] - solution.row(c).transpose()).norm() < 1e-12 * scale);
     }
   }
@@ -329,6 +338,63 @@ TEST_CASE("Spline fit in R^3 with a roughness penalty solves the penalised norma
   options.degree = 1;
   CHECK(bireg::SplineRegression<R3>(options).fit(f, t).message ==
         "roughness_penalty needs degree 2 or 3: it couples control points two apart");
+}
+
+// With a penalty the data need not determine every control point
+// (splines.md §12, "Knots finer than the data"): a gap of 2 units (40
+// spans without an observation) and more control points (203) than
+// observations (60) still give the penalised normal equations' solution.
+// Their condition number kappa grows with the gap's length (the
+// penalty's smallest eigenvalues there go like lambda (pi / 40)^4), so the
+// tolerance is kappa times 100 roundings of the solution's scale. Without
+// the penalty the same knots are refused, and a penalised fit too needs two
+// distinct covariates of positive weight (the penalty's null space, a
+// geodesic, is left to the data).
+TEST_CASE("Penalised spline fit in R^3: knots finer than the data, and a gap", "[spline]") {
+  std::mt19937 rng(37);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::vector<R3::Element> f;
+  std::vector<double> t, w;
+  for (int i = 0; i < 60; ++i) {
+    double at = 8 * uniform(rng);
+    if (at > 4) at += 2;  // nothing in (4, 6)
+    t.push_back(at);
+    w.push_back(0.5 + uniform(rng));
+    f.push_back(R3::Element(std::sin(at), std::cos(0.7 * at), 0.1 * at) +
+                bireg_test::normal_tangent<R3::Tangent>(rng, 0.1));
+  }
+  bireg::SplineOptions<double> options;
+  options.knot_spacing = 0.05;
+  for (const double lambda : {1.0, 100.0}) {
+    options.roughness_penalty = lambda;
+    const auto fit = bireg::SplineRegression<R3>(options).fit(f, t, w);
+    INFO("lambda " << lambda << ": " << fit.message);
+    REQUIRE(fit.ok());
+    const auto& curve = *fit.spline;
+    REQUIRE(curve.control_points().size() > t.size());
+    const DenseSolution dense = dense_penalised_solution(curve, t, f, w, lambda);
+    const double tolerance = 100 * std::numeric_limits<double>::epsilon() * dense.condition *
+                             dense.points.cwiseAbs().maxCoeff();
+    INFO("condition " << dense.condition);
+    for (std::size_t c = 0; c < curve.control_points().size(); ++c)
+      CHECK((curve.control_points()[c] - dense.points.row(c).transpose()).norm() < tolerance);
+  }
+  options.roughness_penalty = 0;
+  CHECK(bireg::SplineRegression<R3>(options).fit(f, t, w).message.find(
+            "control points for 60 observations; use a wider spacing") != std::string::npos);
+  options.roughness_penalty = 1;
+  options.knot_spacing = 1e-4;  // 100,000 spans: more than 16 control points per observation
+  CHECK(bireg::SplineRegression<R3>(options).fit(f, t, w).message.find(
+            "(a penalised fit takes up to 16 per observation)") != std::string::npos);
+  options.knot_spacing = 0.5;
+  std::vector<double> weights(t.size(), 0.0);
+  weights[3] = 1;
+  weights[7] = 1;
+  std::vector<double> same = t;
+  same[7] = same[3];
+  const auto single = bireg::SplineRegression<R3>(options).fit(f, same, weights);
+  CHECK(single.message.find("the observations with positive weight share one covariate") !=
+        std::string::npos);
 }
 
 // The same at the sizes where the fit works in pieces: 12,000 observations
@@ -393,11 +459,7 @@ TEST_CASE("Spline fit is left and right equivariant", "[spline]") {
     const bireg::Spline<G> truth(3, 0.0, 1.0, random_points<G>(rng, 8, 0.4));
     const Samples<G> data = sample(truth, 120, 0.1, rng);
     const auto g = G::exp(bireg_test::normal_tangent<typename G::Tangent>(rng, 1.0));
-    auto left = data.f, right = data.f;
-    for (std::size_t i = 0; i < left.size(); ++i) {
-      left[i] = G::compose(g, data.f[i]);
-      right[i] = G::compose(data.f[i], g);
-    }
+    const auto [left, right] = bireg_test::translated<G>(data.f, g);
     for (const double penalty : {0.0, 0.5}) {
       bireg::SplineOptions<double> options;
       options.knot_spacing = 1.0;
@@ -547,11 +609,7 @@ TEST_CASE("Knot spacing by cross-validation: invariant and refusals stated", "[s
   CHECK(selection.knot_spacing == grid[best]);
 
   const SO3::Element g = SO3::exp(SO3::Tangent(0.3, -1.1, 0.7));
-  auto left = data.f, right = data.f;
-  for (std::size_t i = 0; i < left.size(); ++i) {
-    left[i] = SO3::compose(g, data.f[i]);
-    right[i] = SO3::compose(data.f[i], g);
-  }
+  const auto [left, right] = bireg_test::translated<SO3>(data.f, g);
   for (const auto& moved : {left, right}) {
     const auto other = bireg::select_knot_spacing<SO3>(moved, data.t, options, grid);
     REQUIRE(other.ok());

@@ -324,6 +324,10 @@ class SplineRegression {
 
   // S = ceil(range / spacing), refused where the control points would
   // outnumber the observations (the equations could not be determined).
+  // With a roughness penalty the penalty determines what the data do not
+  // (docs/splines.md §12, "Knots finer than the data"): refused only past
+  // kPenalisedPointsPerObservation control points per observation, where
+  // the knots are absurdly fine and only memory would be spent.
   std::optional<Rejection> make_knots(const Problem<Scalar>& problem, Knots& knots) const {
     using Wide = CovariateScalar<Scalar>;
     using std::ceil;
@@ -334,16 +338,21 @@ class SplineRegression {
     // A spacing within rounding of range / S gives S, not S + 1.
     const Wide segments =
         std::max(Wide(1), ceil(ratio * (1 - 8 * std::numeric_limits<Wide>::epsilon())));
-    if (!(segments + Wide(k) <= Wide(n))) {
+    const bool penalised = options_.roughness_penalty > 0;
+    const Wide most = penalised ? Wide(kPenalisedPointsPerObservation) * Wide(n) : Wide(n);
+    if (!(segments + Wide(k) <= most)) {
       const auto count = [](Wide x) {  // a whole number, as one
         return x < Wide(1e18) ? std::to_string(static_cast<unsigned long long>(x))
                               : std::to_string(double(x));
       };
-      return Rejection{"knot spacing " + std::to_string(double(options_.knot_spacing)) +
-                       " cuts the range " + std::to_string(double(range)) + " into " +
-                       count(segments) + " segments: " + count(segments + Wide(k)) +
-                       " control points for " + std::to_string(n) +
-                       " observations; use a wider spacing"};
+      return Rejection{
+          "knot spacing " + std::to_string(double(options_.knot_spacing)) + " cuts the range " +
+          std::to_string(double(range)) + " into " + count(segments) + " segments: " +
+          count(segments + Wide(k)) + " control points for " + std::to_string(n) + " observations" +
+          (penalised ? " (a penalised fit takes up to " +
+                           std::to_string(kPenalisedPointsPerObservation) + " per observation)"
+                     : std::string()) +
+          "; use a wider spacing"};
     }
     knots.segments = static_cast<std::size_t>(segments);
     knots.control_points = knots.segments + k;
@@ -354,10 +363,15 @@ class SplineRegression {
   // Schoenberg-Whitney (splines.md §7): distinct covariates s_1 < ... < s_M
   // of positive weight with B_c(s_c) > 0 for every c. Greedy in covariate
   // order, which finds such a choice whenever one exists; the first control
-  // point left without one is named with its support.
+  // point left without one is named with its support. With a roughness
+  // penalty K is positive definite once the data determine the penalty's
+  // null space, the curves of equal increments (geodesics, splines.md
+  // §12): two distinct covariates of positive weight, which make_problem
+  // requires of every fit.
   std::optional<Rejection> check_schoenberg_whitney(const Problem<Scalar>& problem,
                                                     const std::vector<std::size_t>& order,
                                                     const Knots& knots) const {
+    if (options_.roughness_penalty > 0) return std::nullopt;  // make_problem has checked
     const int k = options_.degree;
     std::size_t next = 0;  // position in `order`
     Scalar last = -1;      // the covariate given to the previous control point
@@ -448,6 +462,10 @@ class SplineRegression {
                });
     return points;
   }
+
+  // The most control points per observation of a penalised fit
+  // (make_knots).
+  static constexpr std::size_t kPenalisedPointsPerObservation = 16;
 
   // Control points per piece of a pass over them on the pool (an exp and
   // a product each: 1024 take about 30 us on SO(3)).
