@@ -51,4 +51,21 @@ Samples<G> sample(const bireg::Spline<G>& curve, std::size_t n, double noise, st
   return out;
 }
 
+// The observations translated by g on the left (g f_i) and on the right
+// (f_i g): the data of the equivariance and invariance tests.
+template <class G>
+struct Translated {
+  std::vector<typename G::Element> left, right;
+};
+
+template <class G>
+Translated<G> translated(const std::vector<typename G::Element>& f, const typename G::Element& g) {
+  Translated<G> out{f, f};
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    out.left[i] = G::compose(g, f[i]);
+    out.right[i] = G::compose(f[i], g);
+  }
+  return out;
+}
+
 }  // namespace bireg_test

@@ -27,7 +27,8 @@
 // LAMBDA|auto (default 0: none; degree 2 or 3) adds the second-difference
 // penalty of SplineOptions::roughness_penalty; auto chooses lambda by
 // cross-validation at the knot spacing given, or at 1.5 median sample
-// spacings with --knot-spacing auto, and adds "roughness_selection";
+// spacings with --knot-spacing auto (then "knot_spacing_source" is
+// "fine"), and adds "roughness_selection";
 // "roughness_penalty" and its "roughness_penalty_source" are always
 // there. --output-trajectory
 // writes the spline at every input time. The geodesic's solver, series,

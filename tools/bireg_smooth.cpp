@@ -305,6 +305,13 @@ std::optional<std::string> parse_command(int argc, char** argv, Command& command
   if (!command.spline && !command.spline_options.empty()) {
     return command.spline_options.front() + " applies to --method spline only";
   }
+  // --cv-table writes the curve of an automatic choice: refused without one.
+  if (!command.cv_table.empty()) {
+    if (command.spline && command.knot_spacing && command.roughness_penalty) {
+      return "--cv-table goes with --knot-spacing auto or --roughness-penalty auto";
+    }
+    if (!command.spline && command.bandwidth) return "--cv-table goes with --bandwidth auto";
+  }
   if (command.degree == 1 && command.roughness_penalty != 0.0) {
     return "--roughness-penalty needs --degree 2 or 3 (the penalty couples control points two "
            "apart)";

@@ -17,35 +17,19 @@
 namespace bireg_cli {
 namespace {
 
-// The cross-validation curve of --knot-spacing auto, one row per spacing:
-// its criterion (empty where refused), failed fits, and why it was refused.
-std::optional<std::string> write_knot_table(const std::string& path,
-                                            const bireg::KnotSpacingSelection<double>& selection) {
-  std::string text = "knot_spacing,criterion,failures,refused\n";
-  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
-    bireg::io::append_double(text, selection.grid[k]);
+// The cross-validation curve of --knot-spacing auto or --roughness-penalty
+// auto, one row per grid value (`name`: knot_spacing or
+// roughness_penalty): its criterion (empty where refused), failed fits,
+// and why it was refused.
+std::optional<std::string> write_curve_table(const std::string& path, const char* name,
+                                             const bireg::SplineGridCurve<double>& curve) {
+  std::string text = std::string(name) + ",criterion,failures,refused\n";
+  for (std::size_t k = 0; k < curve.grid.size(); ++k) {
+    bireg::io::append_double(text, curve.grid[k]);
     text += ',';
-    if (std::isfinite(selection.criterion[k])) {
-      bireg::io::append_double(text, selection.criterion[k]);
-    }
-    text += ',' + std::to_string(selection.failures[k]) + ',' +
-            bireg_cli::csv_field(selection.refusals[k]) + '\n';
-  }
-  return bireg_cli::write_text_file(path, text);
-}
-
-// The same for --roughness-penalty auto, one row per lambda.
-std::optional<std::string> write_roughness_table(
-    const std::string& path, const bireg::RoughnessPenaltySelection<double>& selection) {
-  std::string text = "roughness_penalty,criterion,failures,refused\n";
-  for (std::size_t k = 0; k < selection.grid.size(); ++k) {
-    bireg::io::append_double(text, selection.grid[k]);
-    text += ',';
-    if (std::isfinite(selection.criterion[k])) {
-      bireg::io::append_double(text, selection.criterion[k]);
-    }
-    text += ',' + std::to_string(selection.failures[k]) + ',' +
-            bireg_cli::csv_field(selection.refusals[k]) + '\n';
+    if (std::isfinite(curve.criterion[k])) bireg::io::append_double(text, curve.criterion[k]);
+    text += ',' + std::to_string(curve.failures[k]) + ',' +
+            bireg_cli::csv_field(curve.refusals[k]) + '\n';
   }
   return bireg_cli::write_text_file(path, text);
 }
@@ -70,6 +54,8 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
   out.selection.reset();
   out.roughness_selection.reset();
   const bool roughness_auto = !request.roughness_penalty.has_value();
+  // A lambda given is the model whose knot spacing is cross-validated.
+  if (!roughness_auto) options.roughness_penalty = *request.roughness_penalty;
   if (request.knot_spacing) {
     options.knot_spacing = *request.knot_spacing;
   } else if (roughness_auto) {
@@ -90,7 +76,7 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
     progress.finish();
     const bireg::KnotSpacingSelection<double>& selection = *out.selection;
     if (!request.cv_table.empty()) {
-      if (auto error = write_knot_table(request.cv_table, selection)) {
+      if (auto error = write_curve_table(request.cv_table, "knot_spacing", selection)) {
         std::fprintf(stderr, "%s: %s\n", tool, error->c_str());
         return kExitWriteError;
       }
@@ -108,9 +94,7 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
       std::fprintf(stderr, "%s: warning: knot spacing auto: %s\n", tool, selection.message.c_str());
     }
   }
-  if (!roughness_auto) {
-    options.roughness_penalty = *request.roughness_penalty;
-  } else {
+  if (roughness_auto) {
     const std::vector<double> grid =
         bireg::auto_roughness_penalty_grid(trajectory.covariates, double(options.knot_spacing));
     Progress progress(tool, request.progress);
@@ -122,7 +106,7 @@ std::optional<int> fit_spline(const char* tool, const SplineRequest& request,
     progress.finish();
     const bireg::RoughnessPenaltySelection<double>& selection = *out.roughness_selection;
     if (!request.cv_table.empty()) {
-      if (auto error = write_roughness_table(request.cv_table, selection)) {
+      if (auto error = write_curve_table(request.cv_table, "roughness_penalty", selection)) {
         std::fprintf(stderr, "%s: %s\n", tool, error->c_str());
         return kExitWriteError;
       }

@@ -80,7 +80,10 @@ class SplineRegression:
                                  f"{self.roughness_penalty!r}")
             roughness = 0.0
         else:
-            roughness = float(self.roughness_penalty)
+            try:
+                roughness = float(self.roughness_penalty)
+            except (TypeError, ValueError):
+                roughness = float("nan")
             if not (roughness >= 0 and np.isfinite(roughness)):
                 raise ValueError("roughness_penalty must be a finite number >= 0 or 'auto', "
                                  f"got {self.roughness_penalty!r}")

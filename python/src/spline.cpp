@@ -66,6 +66,8 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
   bireg::KnotSpacingSelection<double> selection;
   bireg::RoughnessPenaltySelection<double> roughness;
   const bool automatic = !(knot_spacing > 0) && !roughness_auto;
+  // A lambda given is the model whose knot spacing is cross-validated.
+  if (!roughness_auto) options.roughness_penalty = roughness_penalty;
   {
     nb::gil_scoped_release release;
     if (automatic) {
@@ -82,8 +84,6 @@ nb::dict fit_spline(const Vector& t, const Stack& y, const Vector& w, int degree
           poses, covariates, options,
           bireg::auto_roughness_penalty_grid(covariates, double(options.knot_spacing)));
       options.roughness_penalty = roughness.roughness_penalty;
-    } else {
-      options.roughness_penalty = roughness_penalty;
     }
     if ((!automatic || selection.ok()) && (!roughness_auto || roughness.ok()))
       fit = bireg::SplineRegression<G>(options).fit(poses, covariates, weights);

@@ -114,7 +114,7 @@ def test_refusals_are_value_errors(rng):
         bireg.SplineRegression(group="SO3", knot_spacing="wide").fit(t, Y)
     with pytest.raises(ValueError, match="knot_spacing must be"):
         bireg.SplineRegression(group="SO3", knot_spacing=-1.0).fit(t, Y)
-    for bad in ("smooth", -1.0, np.nan):
+    for bad in ("smooth", -1.0, np.nan, None):
         with pytest.raises(ValueError, match="roughness_penalty must be"):
             bireg.SplineRegression(group="SO3", roughness_penalty=bad).fit(t, Y)
     with pytest.raises(ValueError, match="degree 2 or 3"):

@@ -42,9 +42,10 @@
 
 namespace bireg {
 
+// What a spline's cross-validation over a grid reports, whatever the grid
+// is of (knot spacings here, roughness penalties in spline_roughness.hpp).
 template <class Scalar>
-struct KnotSpacingSelection {
-  Scalar knot_spacing = 0;   // the choice (0: none)
+struct SplineGridCurve {
   std::vector<Scalar> grid;  // ascending
   // det(S)^(1/d) per grid value; infinite where refused.
   std::vector<Scalar> criterion;
@@ -57,6 +58,11 @@ struct KnotSpacingSelection {
   // What a user should be told (a choice at the edge, why nothing could be
   // chosen); empty when there is nothing to say.
   std::string message;
+};
+
+template <class Scalar>
+struct KnotSpacingSelection : SplineGridCurve<Scalar> {
+  Scalar knot_spacing = 0;  // the choice (0: none)
   bool ok() const { return knot_spacing > 0; }
 };
 
@@ -196,13 +202,46 @@ std::size_t smallest_unrefused(const std::vector<Scalar>& criterion,
   return best;
 }
 
-// Empty when the grid is positive and ascending, else what is wrong.
+// Nothing can be tried: every grid value refused for the one reason, so
+// that the per-value vectors always match the grid.
 template <class Scalar>
-std::string grid_problem(const std::vector<Scalar>& grid, const char* what) {
+void refuse_every_value(SplineGridCurve<Scalar>& curve, const std::string& message) {
+  curve.message = message;
+  curve.criterion.assign(curve.grid.size(), std::numeric_limits<Scalar>::infinity());
+  curve.failures.assign(curve.grid.size(), 0);
+  curve.refusals.assign(curve.grid.size(), "not tried: " + message);
+}
+
+// The choice at grid index `best` (grid.size(): none) said in `curve`'s
+// message where there is something to say; `what` names the grid's values
+// ("knot spacing"). Returns whether there is a choice.
+template <class Scalar>
+bool settle_choice(SplineGridCurve<Scalar>& curve, std::size_t best, const std::string& what) {
+  const std::size_t size = curve.grid.size();
+  if (best == size) {
+    curve.message = "every " + what + " was refused; the first: " + curve.refusals[0];
+    return false;
+  }
+  curve.at_edge = best == 0 || best + 1 == size;
+  if (curve.at_edge) {
+    curve.message = "the chosen " + what + " is the grid's " +
+                    (best == 0 ? "smallest" : "largest") +
+                    " value: the best may lie beyond the grid";
+  }
+  return true;
+}
+
+// Empty when the grid is positive and ascending (and finite unless
+// `infinite_allowed`: a knot spacing may be infinite, one segment), else
+// what is wrong.
+template <class Scalar>
+std::string grid_problem(const std::vector<Scalar>& grid, const char* what, bool infinite_allowed) {
   for (std::size_t v = 0; v < grid.size(); ++v) {
-    if (!(grid[v] > 0) || !std::isfinite(grid[v]) || (v > 0 && !(grid[v] > grid[v - 1]))) {
-      return std::string("the ") + what + " grid must be positive, finite and ascending (value " +
-             std::to_string(v) + ")";
+    if (!(grid[v] > 0) || (!infinite_allowed && !std::isfinite(grid[v])) ||
+        (v > 0 && !(grid[v] > grid[v - 1]))) {
+      return std::string("the ") + what + " grid must be positive" +
+             (infinite_allowed ? "" : ", finite") + " and ascending (value " + std::to_string(v) +
+             ")";
     }
   }
   return {};
@@ -222,13 +261,8 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
   using Scalar = typename G::Scalar;
   KnotSpacingSelection<Scalar> selection;
   selection.grid = grid;
-  // Nothing can be tried: every grid value refused for the one reason, so
-  // that the per-value vectors always match the grid.
   const auto refuse_all = [&](const std::string& message) {
-    selection.message = message;
-    selection.criterion.assign(grid.size(), std::numeric_limits<Scalar>::infinity());
-    selection.failures.assign(grid.size(), 0);
-    selection.refusals.assign(grid.size(), "not tried: " + message);
+    detail::refuse_every_value(selection, message);
     return selection;
   };
   const std::size_t n = observations.size();
@@ -237,7 +271,7 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
         "knot spacing selection needs a grid, at least 2 folds and at least 2 "
         "observations per fold");
   }
-  const std::string bad_grid = detail::grid_problem(grid, "knot spacing");
+  const std::string bad_grid = detail::grid_problem(grid, "knot spacing", true);
   if (!bad_grid.empty()) return refuse_all(bad_grid);
   const auto dealt = detail::deal_spline_folds<Scalar>(covariates, folds);
   SplineOptions<Scalar> fixed = options;
@@ -270,17 +304,7 @@ KnotSpacingSelection<typename G::Scalar> select_knot_spacing(
   }
   if (progress) progress(fits, fits);
   const std::size_t best = detail::smallest_unrefused(selection.criterion, selection.refusals);
-  if (best == grid.size()) {
-    selection.message = "every knot spacing was refused; the first: " + selection.refusals[0];
-    return selection;
-  }
-  selection.knot_spacing = grid[best];
-  selection.at_edge = best == 0 || best + 1 == grid.size();
-  if (selection.at_edge) {
-    selection.message = std::string("the chosen knot spacing is the grid's ") +
-                        (best == 0 ? "smallest" : "largest") +
-                        " value: the best may lie beyond the grid";
-  }
+  if (detail::settle_choice(selection, best, "knot spacing")) selection.knot_spacing = grid[best];
   return selection;
 }
 

@@ -26,25 +26,16 @@
 
 namespace bireg {
 
+// The curve over lambda (SplineGridCurve: criterion, failures, refusals
+// per value) and the choice.
 template <class Scalar>
-struct RoughnessPenaltySelection {
+struct RoughnessPenaltySelection : SplineGridCurve<Scalar> {
   Scalar roughness_penalty = 0;  // the choice (0: none)
-  std::vector<Scalar> grid;      // ascending
-  // det(S)^(1/d) per grid value; infinite where refused.
-  std::vector<Scalar> criterion;
-  // Per grid value: the fits that failed (the full fit counts as one) and
-  // why the value was refused (empty: it was not).
-  std::vector<std::size_t> failures;
-  std::vector<std::string> refusals;
-  // The choice is the grid's first or last value: the best may lie beyond.
-  bool at_edge = false;
-  // What a user should be told; empty when there is nothing to say.
-  std::string message;
   bool ok() const { return roughness_penalty > 0; }
 };
 
-// Geometric, four values a decade, in units of w = N min(h, range) /
-// range, the observations per knot span. In R^n the penalised fit is a
+// Geometric, at least four values a decade, in units of w = N / S, the
+// observations per knot span (S = ceil(range / h) spans, at least 1). In R^n the penalised fit is a
 // kernel smoother whose window is about (lambda / w)^(1/4) knot spans (the
 // second-difference P-spline's), so the grid runs from 1e-4 w (a tenth of
 // a span: the penalty barely felt) to w W^4 with W = min(S, 100) the
@@ -60,12 +51,13 @@ std::vector<Scalar> auto_roughness_penalty_grid(const std::vector<Scalar>& covar
   using std::log10;
   using std::pow;
   std::vector<Scalar> grid;
-  if (covariates.size() < 2 || !(knot_spacing > 0)) return grid;
+  if (covariates.size() < 2 || !(knot_spacing > 0) || !std::isfinite(knot_spacing)) return grid;
   const auto [lowest, highest] = std::minmax_element(covariates.begin(), covariates.end());
   const Scalar range = *highest - *lowest;
   if (!(range > 0) || !std::isfinite(range)) return grid;
-  const Scalar per_span = Scalar(covariates.size()) * std::min(knot_spacing, range) / range;
-  const Scalar widest = std::min(ceil(range / knot_spacing), Scalar(100));
+  const Scalar spans = std::max(Scalar(1), ceil(range / knot_spacing));
+  const Scalar per_span = Scalar(covariates.size()) / spans;
+  const Scalar widest = std::min(spans, Scalar(100));
   const Scalar low = Scalar(-4);
   const Scalar high = Scalar(4) * log10(widest);
   const int values = 1 + static_cast<int>(ceil(Scalar(kRoughnessValuesPerDecade) * (high - low)));
@@ -78,8 +70,10 @@ std::vector<Scalar> auto_roughness_penalty_grid(const std::vector<Scalar>& covar
 // covariate spacings, as fine as the fits of the folds allow (each holds
 // 4/5 of the observations: 5 knot spans for every 6 of them) and as coarse
 // as the x-IMU recording's velocity allowed without loss (docs/splines.md
-// §12); lambda then does the smoothing. 0 when the covariates have no
-// spacing.
+// §12); lambda then does the smoothing. Never so fine that a fold of 4/5
+// of N observations has fewer than S + 4 of them (the count a cubic's
+// S + 3 control points need, and one more), whatever the spacings' spread.
+// 0 when the covariates have no spacing.
 template <class Scalar>
 Scalar fine_knot_spacing(std::vector<Scalar> covariates) {
   std::sort(covariates.begin(), covariates.end());
@@ -89,7 +83,10 @@ Scalar fine_knot_spacing(std::vector<Scalar> covariates) {
   }
   if (gaps.empty()) return Scalar(0);
   std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-  return Scalar(1.5) * gaps[gaps.size() / 2];
+  const Scalar range = covariates.back() - covariates.front();
+  const auto fold = static_cast<std::ptrdiff_t>(covariates.size() * 4 / 5);
+  const Scalar most_spans = Scalar(std::max<std::ptrdiff_t>(1, fold - 4));
+  return std::max(Scalar(1.5) * gaps[gaps.size() / 2], range / most_spans);
 }
 
 // Cross-validates the grid of lambdas (ascending, positive) with `folds`
@@ -109,18 +106,9 @@ RoughnessPenaltySelection<typename G::Scalar> select_roughness_penalty(
   RoughnessPenaltySelection<Scalar> selection;
   selection.grid = grid;
   const auto refuse_all = [&](const std::string& message) {
-    selection.message = message;
-    selection.criterion.assign(grid.size(), std::numeric_limits<Scalar>::infinity());
-    selection.failures.assign(grid.size(), 0);
-    selection.refusals.assign(grid.size(), "not tried: " + message);
+    detail::refuse_every_value(selection, message);
     return selection;
   };
-  const std::size_t n = observations.size();
-  if (grid.empty() || folds < 2 || covariates.size() != n || n < 2 * folds) {
-    return refuse_all(
-        "roughness penalty selection needs a grid, at least 2 folds and at least 2 "
-        "observations per fold");
-  }
   if (options.degree < 2 || options.degree > 3) {
     return refuse_all(
         "roughness penalty selection needs degree 2 or 3 (the penalty couples "
@@ -129,7 +117,13 @@ RoughnessPenaltySelection<typename G::Scalar> select_roughness_penalty(
   if (!(options.knot_spacing > 0) || !std::isfinite(double(options.knot_spacing))) {
     return refuse_all("roughness penalty selection needs a finite positive knot spacing");
   }
-  const std::string bad_grid = detail::grid_problem(grid, "roughness penalty");
+  const std::size_t n = observations.size();
+  if (grid.empty() || folds < 2 || covariates.size() != n || n < 2 * folds) {
+    return refuse_all(
+        "roughness penalty selection needs a grid, at least 2 folds and at least 2 "
+        "observations per fold");
+  }
+  const std::string bad_grid = detail::grid_problem(grid, "roughness penalty", false);
   if (!bad_grid.empty()) return refuse_all(bad_grid);
   const auto dealt = detail::deal_spline_folds<Scalar>(covariates, folds);
   SplineOptions<Scalar> fixed = options;
@@ -160,17 +154,8 @@ RoughnessPenaltySelection<typename G::Scalar> select_roughness_penalty(
       best = v;
   }
   if (progress) progress(fits, fits);
-  if (best == grid.size()) {
-    selection.message = "every roughness penalty was refused; the first: " + selection.refusals[0];
-    return selection;
-  }
-  selection.roughness_penalty = grid[best];
-  selection.at_edge = best == 0 || best + 1 == grid.size();
-  if (selection.at_edge) {
-    selection.message = std::string("the chosen roughness penalty is the grid's ") +
-                        (best == 0 ? "smallest" : "largest") +
-                        " value: the best may lie beyond the grid";
-  }
+  if (detail::settle_choice(selection, best, "roughness penalty"))
+    selection.roughness_penalty = grid[best];
   return selection;
 }
 
