@@ -104,9 +104,9 @@ def chunk_sums(group: str, request: Annotated[NDArray[numpy.float64], dict(shape
     bireg::chunk_sums<G> of one chunk (observation i is the whole set's offset + i), request and sums as numbers. The GIL is released.
     """
 
-def spline_fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], degree: int, knot_spacing: float, tol: float, max_iter: int, threads: int) -> dict:
+def spline_fit(group: str, t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], y: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], weights: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)], degree: int, knot_spacing: float, roughness_penalty: float, roughness_auto: bool, tol: float, max_iter: int, threads: int) -> dict:
     """
-    bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing).
+    bireg::SplineRegression<G>::fit (knot_spacing <= 0: chosen by select_knot_spacing, or fine_knot_spacing with roughness_auto; roughness_auto: lambda by select_roughness_penalty).
     """
 
 def spline_evaluate(group: str, degree: int, first_knot: float, spacing: float, control_points: Annotated[NDArray[numpy.float64], dict(shape=(None, None, None), order='C', device='cpu', writable=False)], t: Annotated[NDArray[numpy.float64], dict(shape=(None,), order='C', device='cpu', writable=False)]) -> dict:
