@@ -127,7 +127,8 @@ GeodesicFile<G> geodesic_file(const typename G::Tangent& start, const typename G
   GeodesicFile<G> file;
   file.g0 = G::exp(start);
   file.velocity = velocity;
-  std::normal_distribution<double> normal(0.0, noise);
+  // (A standard deviation of 0 is invalid: libstdc++'s assertions abort.)
+  std::normal_distribution<double> normal(0.0, noise > 0 ? noise : 1.0);
   for (int k = 0; k < n; ++k) {
     typename G::Element g = file.at(k / 10.0);
     if (noise > 0) {
