@@ -66,6 +66,19 @@ struct KnotSpacingSelection : SplineGridCurve<Scalar> {
   bool ok() const { return knot_spacing > 0; }
 };
 
+// The median of the positive gaps between sorted covariates; 0 when there
+// is none (fewer than two distinct covariates).
+template <class Scalar>
+Scalar median_covariate_gap(const std::vector<Scalar>& sorted) {
+  std::vector<Scalar> gaps;
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    if (sorted[i] > sorted[i - 1]) gaps.push_back(sorted[i] - sorted[i - 1]);
+  }
+  if (gaps.empty()) return Scalar(0);
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  return gaps[gaps.size() / 2];
+}
+
 // 24 spacings, geometric, from 1.25 median covariate spacings (fewer
 // control points than observations) to the whole range (one segment).
 template <class Scalar>
@@ -73,14 +86,10 @@ std::vector<Scalar> auto_knot_spacing_grid(std::vector<Scalar> covariates) {
   std::vector<Scalar> grid;
   std::sort(covariates.begin(), covariates.end());
   if (covariates.size() < 2) return grid;
-  std::vector<Scalar> gaps;
-  for (std::size_t i = 1; i < covariates.size(); ++i) {
-    if (covariates[i] > covariates[i - 1]) gaps.push_back(covariates[i] - covariates[i - 1]);
-  }
+  const Scalar gap = median_covariate_gap(covariates);
   const Scalar range = covariates.back() - covariates.front();
-  if (gaps.empty() || !(range > 0)) return grid;
-  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-  const Scalar smallest = std::min(range, Scalar(1.25) * gaps[gaps.size() / 2]);
+  if (!(gap > 0) || !(range > 0)) return grid;
+  const Scalar smallest = std::min(range, Scalar(1.25) * gap);
   constexpr int kValues = 24;
   for (int v = 0; v < kValues; ++v)
     grid.push_back(smallest * std::pow(range / smallest, Scalar(v) / Scalar(kValues - 1)));

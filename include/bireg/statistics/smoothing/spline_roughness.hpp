@@ -35,13 +35,13 @@ struct RoughnessPenaltySelection : SplineGridCurve<Scalar> {
 };
 
 // Geometric, at least four values a decade, in units of w = N / S, the
-// observations per knot span (S = ceil(range / h) spans, at least 1). In R^n the penalised fit is a
-// kernel smoother whose window is about (lambda / w)^(1/4) knot spans (the
-// second-difference P-spline's), so the grid runs from 1e-4 w (a tenth of
-// a span: the penalty barely felt) to w W^4 with W = min(S, 100) the
-// widest window, S the number of spans: a window of the whole range or of
-// a hundred spans, whichever is shorter. Empty when the covariates have no
-// range or the spacing is not positive.
+// observations per knot span (S = ceil(range / h) spans, at least 1). In
+// R^n the penalised fit is a kernel smoother whose window is about
+// (lambda / w)^(1/4) knot spans (the second-difference P-spline's), so the
+// grid runs from 1e-4 w (a tenth of a span: the penalty barely felt) to
+// w W^4 with W = min(S, 100) the widest window: a window of the whole
+// range or of a hundred spans, whichever is shorter. Empty when the
+// covariates have no range or the spacing is not positive and finite.
 constexpr int kRoughnessValuesPerDecade = 4;
 
 template <class Scalar>
@@ -67,26 +67,21 @@ std::vector<Scalar> auto_roughness_penalty_grid(const std::vector<Scalar>& covar
 }
 
 // The knots of a penalised spline when none are given: 1.5 median
-// covariate spacings, as fine as the fits of the folds allow (each holds
-// 4/5 of the observations: 5 knot spans for every 6 of them) and as coarse
-// as the x-IMU recording's velocity allowed without loss (docs/splines.md
-// §12); lambda then does the smoothing. Never so fine that a fold of 4/5
-// of N observations has fewer than S + 4 of them (the count a cubic's
-// S + 3 control points need, and one more), whatever the spacings' spread.
-// 0 when the covariates have no spacing.
+// covariate spacings, as coarse as the x-IMU recording's velocity allowed
+// without loss (docs/splines.md §12); lambda then does the smoothing. Never
+// more spans than a fold of 4/5 of the N observations has observations
+// less 4, whatever the spacings' spread, so that on small or bursty data
+// the folds' fits still rest on their data more than on the penalty. 0
+// when the covariates have no spacing.
 template <class Scalar>
 Scalar fine_knot_spacing(std::vector<Scalar> covariates) {
   std::sort(covariates.begin(), covariates.end());
-  std::vector<Scalar> gaps;
-  for (std::size_t i = 1; i < covariates.size(); ++i) {
-    if (covariates[i] > covariates[i - 1]) gaps.push_back(covariates[i] - covariates[i - 1]);
-  }
-  if (gaps.empty()) return Scalar(0);
-  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  const Scalar gap = median_covariate_gap(covariates);
+  if (!(gap > 0)) return Scalar(0);
   const Scalar range = covariates.back() - covariates.front();
   const auto fold = static_cast<std::ptrdiff_t>(covariates.size() * 4 / 5);
   const Scalar most_spans = Scalar(std::max<std::ptrdiff_t>(1, fold - 4));
-  return std::max(Scalar(1.5) * gaps[gaps.size() / 2], range / most_spans);
+  return std::max(Scalar(1.5) * gap, range / most_spans);
 }
 
 // Cross-validates the grid of lambdas (ascending, positive) with `folds`
